@@ -1,0 +1,45 @@
+# HEDS-5000 encoder-interface IP: build, test and demo entry points. `make help` lists them.
+# Every target bootstraps .venv from requirements.txt on first use (scripts/bootstrap.sh).
+
+SHELL      := /bin/bash
+VENV       := .venv
+STAMP      := $(VENV)/.requirements-installed
+PY         := $(VENV)/bin/python
+SIM        ?= icarus
+JOBS       ?= 2
+WAVES      ?= 0
+SEED       ?=
+
+# scripts/bin holds our Verilator shim; it must come before any system verilator.
+export PATH := $(CURDIR)/scripts/bin:$(CURDIR)/$(VENV)/bin:$(PATH)
+export SIM SEED
+export ENC_WAVES := $(WAVES)
+# cocotb's runner reads WAVES itself and would switch Icarus to FST; we make VCD ourselves.
+unexport WAVES
+
+.DEFAULT_GOAL := help
+
+.PHONY: help venv test lint clean
+
+help: ## list the targets
+	@echo "HEDS-5000 encoder-interface IP -- make targets:"
+	@grep -hE '^[a-z][a-zA-Z_-]*:.*## ' $(MAKEFILE_LIST) | \
+	  awk -F':.*## ' '{ printf "  make %-10s %s\n", $$1, $$2 }'
+	@echo "Variables: SIM=icarus|verilator  WAVES=1 (VCD per test in sim/waves/)  SEED=n  JOBS=n"
+
+$(STAMP): requirements.txt scripts/bootstrap.sh
+	@bash scripts/bootstrap.sh
+
+venv: $(STAMP) ## create .venv from requirements.txt (done automatically by every target)
+
+test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilator; WAVES=1 for VCDs)
+	@case "$(SIM)" in icarus|verilator) ;; *) echo "make test: SIM=$(SIM) is not supported; use SIM=icarus or SIM=verilator" >&2; exit 2;; esac
+	@case "$(WAVES)" in 0|1) ;; *) echo "make test: WAVES=$(WAVES) must be 0 or 1" >&2; exit 2;; esac
+	@case "$(SEED)" in ""|*[!0-9]*) [ -z "$(SEED)" ] || { echo "make test: SEED=$(SEED) must be a non-negative integer" >&2; exit 2; };; esac
+	$(PY) -m pytest -n $(JOBS) tb
+
+lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
+	@bash scripts/lint.sh
+
+clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
+	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Create .venv from the pinned requirements.txt and make sure the system tools the flow needs
+# (Icarus Verilog, a C++ compiler and make for Verilator's model build) are present.
+# Missing system tools are installed with apt-get when running as root; otherwise a one-line
+# message names the package to install. Called by the Makefile; safe to run again.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need_pkgs=()
+command -v iverilog >/dev/null 2>&1 || need_pkgs+=(iverilog)
+command -v g++      >/dev/null 2>&1 || need_pkgs+=(g++)
+command -v make     >/dev/null 2>&1 || need_pkgs+=(make)
+python3 -c 'import venv, ensurepip' >/dev/null 2>&1 || need_pkgs+=(python3-venv)
+
+if [ ${#need_pkgs[@]} -gt 0 ]; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "bootstrap: installing ${need_pkgs[*]} with apt-get"
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_pkgs[@]}" >/dev/null
+  else
+    echo "bootstrap: missing system packages: ${need_pkgs[*]} (install them, e.g. 'sudo apt-get install ${need_pkgs[*]}')" >&2
+    exit 1
+  fi
+fi
+
+py=$(command -v python3) || { echo "bootstrap: python3 (3.9 or newer) is required" >&2; exit 1; }
+"$py" -c 'import sys; sys.exit(sys.version_info < (3, 9))' \
+  || { echo "bootstrap: python3 is $("$py" --version 2>&1); 3.9 or newer is required" >&2; exit 1; }
+
+if [ ! -x .venv/bin/python ]; then
+  echo "bootstrap: creating .venv"
+  "$py" -m venv .venv
+fi
+echo "bootstrap: installing requirements.txt into .venv"
+.venv/bin/python -m pip install -q --disable-pip-version-check -r requirements.txt
+touch .venv/.requirements-installed
