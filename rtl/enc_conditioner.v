@@ -1,0 +1,118 @@
+// enc_conditioner -- input synchronizer and digital filter for the two encoder channels.
+//
+// Does in logic what the note asks of the 74LS14 Schmitt buffer in front of every counting
+// circuit (section CIRCUITS): it makes the asynchronous A and B outputs of the HEDS-5000 safe to
+// sample and rejects short pulses. Per channel:
+//   a_in -> two flip-flops (synchronizer) -> FILTER_LEN-sample filter -> a
+// The filter output takes a new level only after the synchronized input has shown that level on
+// FILTER_LEN consecutive clocks. A level that goes back before FILTER_LEN samples is rejected and
+// `glitch` pulses for one clock. Both channels use identical paths, so their relative timing is
+// kept to the clock: latency from a_in to a is 2 + FILTER_LEN clocks (+ up to one clock of
+// sampling uncertainty). With FILTER_LEN = 1 the filter is a plain register and glitch stays 0.
+`default_nettype none
+
+module enc_conditioner #(
+    parameter integer FILTER_LEN = 3  // samples a new level must persist: 1 .. 16 (1 = no filter)
+) (
+    input  wire clk,
+    input  wire rst,     // synchronous, active high
+    input  wire a_in,    // channel A, asynchronous
+    input  wire b_in,    // channel B, asynchronous
+    output wire a,       // conditioned channel A, synchronous to clk
+    output wire b,       // conditioned channel B, synchronous to clk
+    output wire glitch   // one-clock pulse per rejected level (either channel)
+);
+
+  generate
+    if (FILTER_LEN < 1 || FILTER_LEN > 16) begin : g_bad_filter_len
+`ifdef __ICARUS__
+      enc_conditioner__parameter_FILTER_LEN_must_be_1_to_16 u_stop ();
+`else
+      $error("enc_conditioner: parameter FILTER_LEN must be in 1 .. 16");
+`endif
+    end
+  endgenerate
+
+  // Run-length counter: number of consecutive samples (so far) that differ from the accepted level;
+  // holds 0 .. FILTER_LEN-1.
+  localparam integer CW = (FILTER_LEN <= 2) ? 1 : (FILTER_LEN <= 4) ? 2 :
+                          (FILTER_LEN <= 8) ? 3 : 4;
+  localparam integer LAST_INT = FILTER_LEN - 1;
+  localparam [CW-1:0] LAST = LAST_INT[CW-1:0];  // a differing sample seen with run = LAST accepts
+
+  // ---- synchronizer: two flip-flops per channel -----------------------------------------------
+  reg [1:0] meta_q;  // {b, a} first stage
+  reg [1:0] sync_q;  // {b, a} second stage
+
+  always @(posedge clk) begin
+    if (rst) begin
+      meta_q <= 2'b00;
+      sync_q <= 2'b00;
+    end else begin
+      meta_q <= {b_in, a_in};
+      sync_q <= meta_q;
+    end
+  end
+
+  // ---- filter: the same logic for each channel ------------------------------------------------
+  wire [1:0] level;   // {b, a} accepted levels
+  wire [1:0] reject;  // this clock a candidate level went back before it was accepted
+
+  genvar ch;
+  generate
+    for (ch = 0; ch < 2; ch = ch + 1) begin : g_filter
+      reg          level_q;
+      reg          level_d;
+      reg [CW-1:0] run_q;
+      reg [CW-1:0] run_d;
+      reg          reject_d;
+
+      always @(*) begin
+        level_d  = level_q;
+        run_d    = run_q;
+        reject_d = 1'b0;
+        if (sync_q[ch] != level_q) begin
+          if (run_q == LAST) begin
+            level_d = sync_q[ch];  // FILTER_LEN-th consecutive sample of the new level: accept
+            run_d   = {CW{1'b0}};
+          end else begin
+            run_d = run_q + 1'b1;
+          end
+        end else if (run_q != {CW{1'b0}}) begin
+          run_d    = {CW{1'b0}};   // back to the accepted level too soon: reject
+          reject_d = 1'b1;
+        end
+      end
+
+      always @(posedge clk) begin
+        if (rst) begin
+          level_q <= 1'b0;
+          run_q   <= {CW{1'b0}};
+        end else begin
+          level_q <= level_d;
+          run_q   <= run_d;
+        end
+      end
+
+      assign level[ch]  = level_q;
+      assign reject[ch] = reject_d;
+    end
+  endgenerate
+
+  reg glitch_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      glitch_q <= 1'b0;
+    end else begin
+      glitch_q <= |reject;
+    end
+  end
+
+  assign a      = level[0];
+  assign b      = level[1];
+  assign glitch = glitch_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,128 @@
+// enc_updown_buffer -- Figure 17, the 2X up/down buffer a microprocessor reads.
+//
+// Built as the figure builds it: the encoder channels go through the input conditioner (the
+// 74LS14's job), the Figure 15 XOR edge detector turns every transition of A into a count pulse
+// with its direction, and DIGITS ls168 stages cascaded ripple-carry-out to ENT count it:
+//   a_in, b_in -> enc_conditioner -> enc_x2_xor -> ls168[0] -RCO_n-> ENT_n ls168[1] -> ...
+// The count moves +-1 per transition of A (2 x code wheel count per revolution) and wraps modulo
+// MODULUS**DIGITS both ways (BCD with MODULUS = 10, binary with 16). rst loads zeros (the part
+// has no reset pin). Digit 0 is count[3:0].
+//
+// Coherent read, as the HCTL-2016's inhibit latch: rd_data follows count (one clock behind) while
+// hold = 0; while hold = 1 it is frozen and counting goes on underneath. It catches up on the
+// first clock after hold falls.
+// Extra outputs: `glitch` (a level rejected by the conditioner) and `error` (A and B changed
+// together, direction unknown): whenever the count may be wrong, one of them has pulsed.
+// `rco_n`, the last stage's ripple carry, is low during the clock in which a count wraps the
+// whole counter (overflow counting up, borrow counting down): the note's overflow flag, and the
+// cascade input for more stages.
+`default_nettype none
+
+module enc_updown_buffer #(
+    parameter integer DIGITS     = 4,   // cascaded ls168 stages: 1 .. 8
+    parameter integer MODULUS    = 10,  // 10: BCD ('LS168), 16: binary ('LS169)
+    parameter integer FILTER_LEN = 3    // conditioner filter length: 1 .. 16
+) (
+    input  wire                clk,
+    input  wire                rst,      // synchronous, active high: clears the count
+    input  wire                a_in,     // channel A, asynchronous
+    input  wire                b_in,     // channel B, asynchronous
+    input  wire                hold,     // 1: freeze rd_data for a multi-byte read
+    output wire [4*DIGITS-1:0] count,    // live count, DIGITS digits of 4 bits
+    output wire [4*DIGITS-1:0] rd_data,  // count as the microprocessor reads it
+    output wire                glitch,   // conditioner rejected a short level (one clock)
+    output wire                error,    // A and B changed in one sample (one clock)
+    output wire                rco_n     // top stage RCO_n: low while a count wraps the counter
+);
+
+  generate
+    if (DIGITS < 1 || DIGITS > 8) begin : g_bad_digits
+`ifdef __ICARUS__
+      enc_updown_buffer__parameter_DIGITS_must_be_1_to_8 u_stop ();
+`else
+      $error("enc_updown_buffer: parameter DIGITS must be in 1 .. 8");
+`endif
+    end
+    if (MODULUS != 10 && MODULUS != 16) begin : g_bad_modulus
+`ifdef __ICARUS__
+      enc_updown_buffer__parameter_MODULUS_must_be_10_or_16 u_stop ();
+`else
+      $error("enc_updown_buffer: parameter MODULUS must be 10 or 16");
+`endif
+    end
+    if (FILTER_LEN < 1 || FILTER_LEN > 16) begin : g_bad_filter_len
+`ifdef __ICARUS__
+      enc_updown_buffer__parameter_FILTER_LEN_must_be_1_to_16 u_stop ();
+`else
+      $error("enc_updown_buffer: parameter FILTER_LEN must be in 1 .. 16");
+`endif
+    end
+  endgenerate
+
+  wire a;
+  wire b;
+  wire cnt_pulse;
+  wire up;
+
+  enc_conditioner #(
+      .FILTER_LEN(FILTER_LEN)
+  ) u_conditioner (
+      .clk   (clk),
+      .rst   (rst),
+      .a_in  (a_in),
+      .b_in  (b_in),
+      .a     (a),
+      .b     (b),
+      .glitch(glitch)
+  );
+
+  enc_x2_xor u_x2 (
+      .clk      (clk),
+      .rst      (rst),
+      .a        (a),
+      .b        (b),
+      .cnt_pulse(cnt_pulse),
+      .up       (up),
+      .error    (error)
+  );
+
+  // Cascade: ENP_n common, ENT_n of stage 0 from the count pulse, RCO_n -> ENT_n of the next.
+  wire [DIGITS:0] carry_n  /* verilator split_var */;
+  assign carry_n[0] = ~cnt_pulse;
+
+  genvar k;
+  generate
+    for (k = 0; k < DIGITS; k = k + 1) begin : g_digit
+      ls168 #(
+          .MODULUS(MODULUS)
+      ) u_ls168 (
+          .clk   (clk),
+          .load_n(~rst),
+          .enp_n (~cnt_pulse),
+          .ent_n (carry_n[k]),
+          .up    (up),
+          .d     (4'd0),
+          .q     (count[4*k+:4]),
+          .rco_n (carry_n[k+1])
+      );
+    end
+  endgenerate
+
+  assign rco_n = carry_n[DIGITS];
+
+  // Read latch (HCTL-2016 style inhibit).
+  reg [4*DIGITS-1:0] rd_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      rd_q <= {4 * DIGITS{1'b0}};
+    end else if (!hold) begin
+      rd_q <= count;
+    end
+  end
+
+  assign rd_data = rd_q;
+
+endmodule
+
+`default_nettype wire

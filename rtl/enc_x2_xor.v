@@ -1,0 +1,60 @@
+// enc_x2_xor -- Figure 15, the 2X count circuit: XOR edge detector.
+//
+// "The edge detection circuit shown in Figure 15 provides a pulse for each transition of channel
+// A. The Exclusive OR gate toggles at twice the channel frequency of each channel, but when
+// observed coincident with the negative slope of the edge detector output, its state corresponds
+// to the direction of rotation." Here the edge detector is the synchronous compare of A with its
+// previous sample, and the XOR A ^ B is observed on the same clock:
+//   forward  00 -> 10 (A rises, B = 0) and 11 -> 01 (A falls, B = 1): A ^ B = 1 after the edge
+//   reverse  10 -> 00 and 01 -> 11:                                   A ^ B = 0 after the edge
+// One cnt_pulse per transition of A, up = A ^ B; a change of B alone gives none. The first sample
+// after rst is the reference. Extra output `error` (not in Figure 15): both channels changed
+// between two samples, so the direction of that A edge is unknown and the count may be wrong.
+// Outputs are registered: latency 1 clock from the a/b sample.
+`default_nettype none
+
+module enc_x2_xor (
+    input  wire clk,
+    input  wire rst,        // synchronous, active high
+    input  wire a,          // channel A, synchronous to clk
+    input  wire b,          // channel B, synchronous to clk
+    output wire cnt_pulse,  // one clock per transition of A
+    output wire up,         // direction: A ^ B at the edge, 1 = forward
+    output wire error       // one clock when A and B changed together (count direction unknown)
+);
+
+  reg a_prev_q;
+  reg b_prev_q;
+  reg ref_q;    // the previous-sample registers hold a real sample
+  reg cnt_q;
+  reg up_q;
+  reg error_q;
+
+  wire a_edge = ref_q & (a != a_prev_q);
+  wire b_edge = ref_q & (b != b_prev_q);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      a_prev_q <= 1'b0;
+      b_prev_q <= 1'b0;
+      ref_q    <= 1'b0;
+      cnt_q    <= 1'b0;
+      up_q     <= 1'b0;
+      error_q  <= 1'b0;
+    end else begin
+      a_prev_q <= a;
+      b_prev_q <= b;
+      ref_q    <= 1'b1;
+      cnt_q    <= a_edge;
+      up_q     <= a_edge ? (a ^ b) : up_q;
+      error_q  <= a_edge & b_edge;
+    end
+  end
+
+  assign cnt_pulse = cnt_q;
+  assign up        = up_q;
+  assign error     = error_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,59 @@
+// enc_x4_decoder -- 4X quadrature decode by look-up table, in hardware.
+//
+// The note's programmed-input decode (MICROPROCESSOR INTERFACE, DECODE ROUTINE): keep the
+// previous state, and look up "the expected word for the next state in a clockwise rotation".
+// If the present state is that word the shaft moved forward; if the previous state is the
+// expected next word of the present one it moved back; if the state is unchanged nothing
+// happened; anything else (both channels changed between two samples) is an illegal transition.
+//   forward (A leads B): 00 -> 10 -> 11 -> 01 -> 00, so next_fwd({a, b}) = {~b, a}
+// One cnt_pulse per valid transition (4 counts per cycle), up = 1 forward. An illegal transition
+// gives one `error` pulse and no count. The first sample after rst is the reference state and
+// is not counted. Outputs are registered: latency 1 clock from the a/b sample.
+`default_nettype none
+
+module enc_x4_decoder (
+    input  wire clk,
+    input  wire rst,        // synchronous, active high
+    input  wire a,          // channel A, synchronous to clk (from enc_conditioner)
+    input  wire b,          // channel B, synchronous to clk
+    output wire cnt_pulse,  // one clock per valid transition
+    output wire up,         // direction of the count: 1 = forward (A leads)
+    output wire error       // one clock per illegal transition (both channels changed)
+);
+
+  reg  [1:0] prev_q;   // {a, b} at the previous sample
+  reg        ref_q;    // prev_q holds a real sample (cleared by rst)
+  reg        cnt_q;
+  reg        up_q;
+  reg        error_q;
+
+  wire [1:0] cur = {a, b};
+  wire [1:0] next_fwd_of_prev = {~prev_q[0], prev_q[1]};  // the look-up table
+  wire [1:0] next_fwd_of_cur = {~cur[0], cur[1]};
+  wire       fwd = (cur == next_fwd_of_prev);
+  wire       rev = (prev_q == next_fwd_of_cur);
+  wire       moved = (cur != prev_q);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      prev_q  <= 2'b00;
+      ref_q   <= 1'b0;
+      cnt_q   <= 1'b0;
+      up_q    <= 1'b0;
+      error_q <= 1'b0;
+    end else begin
+      prev_q  <= cur;
+      ref_q   <= 1'b1;
+      cnt_q   <= ref_q & (fwd | rev);
+      up_q    <= (ref_q & (fwd | rev)) ? fwd : up_q;
+      error_q <= ref_q & moved & ~fwd & ~rev;
+    end
+  end
+
+  assign cnt_pulse = cnt_q;
+  assign up        = up_q;
+  assign error     = error_q;
+
+endmodule
+
+`default_nettype wire
