@@ -19,7 +19,7 @@ unexport WAVES
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv test lint clean
+.PHONY: help venv test lint clean synth bitstream
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -40,6 +40,12 @@ test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilato
 
 lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
 	@bash scripts/lint.sh
+
+synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K) and the iCEBreaker top; table in sim/synth_results.md
+	$(PY) scripts/synth.py --jobs $(JOBS)
+
+bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
+	$(PY) scripts/synth.py --only icebreaker_top --bitstream
 
 clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
 	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__
