@@ -7,8 +7,9 @@
 // The filter output takes a new level only after the synchronized input has shown that level on
 // FILTER_LEN consecutive clocks. A level that goes back before FILTER_LEN samples is rejected and
 // `glitch` pulses for one clock. Both channels use identical paths, so their relative timing is
-// kept to the clock: latency from a_in to a is 2 + FILTER_LEN clocks (+ up to one clock of
-// sampling uncertainty). With FILTER_LEN = 1 the filter is a plain register and glitch stays 0.
+// kept to the clock: an output changes FILTER_LEN + 1 clocks after the rising edge that first
+// samples the new level (so 1 + FILTER_LEN to 2 + FILTER_LEN clock periods after the input edge).
+// With FILTER_LEN = 1 the filter is a plain register and glitch stays 0.
 `default_nettype none
 
 module enc_conditioner #(

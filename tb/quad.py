@@ -17,7 +17,9 @@ import random
 from dataclasses import dataclass, field
 
 import cocotb
-from cocotb.triggers import Timer
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, RisingEdge, Timer
+from cocotb.utils import get_sim_time
 
 QUAD = ((0, 0), (1, 0), (1, 1), (0, 1))  # forward sequence of (A, B)
 STATE_TO_POS = {ab: p for p, ab in enumerate(QUAD)}
@@ -103,17 +105,46 @@ def with_glitches(wf: Waveform, rng: random.Random, count: int, width_ns: float,
     return out
 
 
-async def play(dut, wf: Waveform, a_name: str = "a_in", b_name: str = "b_in") -> None:
-    """Drive ``wf`` onto the DUT's channel inputs, starting now; returns after the last event."""
+async def play(dut, wf: Waveform, a_name: str = "a_in", b_name: str = "b_in",
+               clock_period_ps: int | None = None) -> None:
+    """Drive ``wf`` onto the DUT's channel inputs, starting now; returns after the last event.
+
+    With ``clock_period_ps`` (a clock whose rising edges fall on multiples of it, as a cocotb
+    Clock started at time 0 does), an event that would land on the very picosecond of a clock
+    edge is moved 1 ps later, so which sample sees it is never a simulator race.
+    """
     a_sig, b_sig = getattr(dut, a_name), getattr(dut, b_name)
+    start_ps = get_sim_time("ps")
     now_ps = 0
     for t_ns, a, b in wf.events:
         t_ps = int(round(t_ns * 1000.0))
+        if clock_period_ps and (start_ps + t_ps) % clock_period_ps == 0:
+            t_ps += 1
         if t_ps > now_ps:
             await Timer(t_ps - now_ps, unit="ps")
             now_ps = t_ps
         a_sig.value = a
         b_sig.value = b
+
+
+async def start_clock(clk, period_ps: int) -> None:
+    """Start a cocotb Clock on ``clk`` whose rising edges fall on multiples of ``period_ps`` in
+    absolute simulation time (each cocotb test starts its own clock, at whatever time the previous
+    test ended), which is what :func:`play`'s ``clock_period_ps`` assumes."""
+    now = get_sim_time("ps")
+    if now % period_ps:
+        await Timer(period_ps - now % period_ps, unit="ps")
+    cocotb.start_soon(Clock(clk, period_ps, unit="ps").start())
+
+
+async def reset_dut(dut, clocks: int = 2) -> None:
+    """Hold ``rst`` for ``clocks`` rising edges, then release it after a falling edge. (The first
+    edge may not be one: a previous test's clock can have stopped high.)"""
+    dut.rst.value = 1
+    for _ in range(clocks):
+        await RisingEdge(dut.clk)
+    await FallingEdge(dut.clk)
+    dut.rst.value = 0
 
 
 def log_seed(dut) -> int:

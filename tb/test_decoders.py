@@ -10,12 +10,11 @@ import random
 
 import cocotb
 import pytest
-from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
 from harness import run
 from models import X1Model, X2Model, X4Model
-from quad import log_seed, state_of
+from quad import log_seed, reset_dut, start_clock, state_of
 
 MODELS = {"enc_x4_decoder": X4Model, "enc_x2_xor": X2Model, "enc_x1_hysteresis": X1Model}
 
@@ -60,13 +59,11 @@ def random_walk(rng, n, start_pos=0, max_clocks=3, p_reverse=0.3, p_illegal=0.0,
 
 
 async def start(dut):
-    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
+    await start_clock(dut.clk, 10_000)
     log_seed(dut)
-    dut.rst.value = 1
     dut.a.value = 0
     dut.b.value = 0
-    await FallingEdge(dut.clk)
-    dut.rst.value = 0
+    await reset_dut(dut)
 
 
 async def play_samples(dut, s: Samples, model=None, bound=None):
