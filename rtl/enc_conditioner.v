@@ -10,6 +10,10 @@
 // kept to the clock: an output changes FILTER_LEN + 1 clocks after the rising edge that first
 // samples the new level (so 1 + FILTER_LEN to 2 + FILTER_LEN clock periods after the input edge).
 // With FILTER_LEN = 1 the filter is a plain register and glitch stays 0.
+// Extra output `valid` (not in the contract's list): rst forces a and b to 0, and the outputs
+// show the real input levels only FILTER_LEN + 2 clocks after rst falls; `valid` rises on that
+// clock. A decoder behind the conditioner should be held in reset until then (rst | ~valid), or
+// it would take 00 as its reference state and count the jump to the real state.
 `default_nettype none
 
 module enc_conditioner #(
@@ -21,7 +25,8 @@ module enc_conditioner #(
     input  wire b_in,    // channel B, asynchronous
     output wire a,       // conditioned channel A, synchronous to clk
     output wire b,       // conditioned channel B, synchronous to clk
-    output wire glitch   // one-clock pulse per rejected level (either channel)
+    output wire glitch,  // one-clock pulse per rejected level (either channel)
+    output wire valid    // a and b reflect the inputs (FILTER_LEN + 2 clocks after rst)
 );
 
   generate
@@ -100,6 +105,21 @@ module enc_conditioner #(
     end
   endgenerate
 
+  // ---- settling after reset: 2 synchronizer clocks + FILTER_LEN filter clocks ------------------
+  localparam integer SETTLE = FILTER_LEN + 2;
+  reg [4:0] settle_q;  // clocks since rst, saturating at SETTLE (<= 18)
+  reg       valid_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      settle_q <= 5'd0;
+      valid_q  <= 1'b0;
+    end else if (!valid_q) begin
+      settle_q <= settle_q + 5'd1;
+      valid_q  <= (settle_q == SETTLE[4:0] - 5'd1);
+    end
+  end
+
   reg glitch_q;
 
   always @(posedge clk) begin
@@ -113,6 +133,7 @@ module enc_conditioner #(
   assign a      = level[0];
   assign b      = level[1];
   assign glitch = glitch_q;
+  assign valid  = valid_q;
 
 endmodule
 

@@ -6,7 +6,9 @@
 //   a_in, b_in -> enc_conditioner -> enc_x2_xor -> ls168[0] -RCO_n-> ENT_n ls168[1] -> ...
 // The count moves +-1 per transition of A (2 x code wheel count per revolution) and wraps modulo
 // MODULUS**DIGITS both ways (BCD with MODULUS = 10, binary with 16). rst loads zeros (the part
-// has no reset pin). Digit 0 is count[3:0].
+// has no reset pin). Digit 0 is count[3:0]. The decoder is held in reset until the conditioner
+// shows the real input levels (FILTER_LEN + 2 clocks after rst falls): the state then is the
+// reference, and motion before it is not counted.
 //
 // Coherent read, as the HCTL-2016's inhibit latch: rd_data follows count (one clock behind) while
 // hold = 0; while hold = 1 it is frozen and counting goes on underneath. It catches up on the
@@ -61,6 +63,7 @@ module enc_updown_buffer #(
 
   wire a;
   wire b;
+  wire cond_valid;
   wire cnt_pulse;
   wire up;
 
@@ -73,12 +76,13 @@ module enc_updown_buffer #(
       .b_in  (b_in),
       .a     (a),
       .b     (b),
-      .glitch(glitch)
+      .glitch(glitch),
+      .valid (cond_valid)
   );
 
   enc_x2_xor u_x2 (
       .clk      (clk),
-      .rst      (rst),
+      .rst      (rst | ~cond_valid),
       .a        (a),
       .b        (b),
       .cnt_pulse(cnt_pulse),

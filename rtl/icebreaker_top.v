@@ -116,7 +116,7 @@ module icebreaker_top #(
   end
 
   // ---- 4X path: conditioner, decoder, position counter -----------------------------------------
-  wire a, b, glitch;
+  wire a, b, glitch, cond_valid;
   wire cnt4, up4, err4;
   reg signed [POS_WIDTH-1:0] pos_q;
   localparam signed [POS_WIDTH-1:0] POS_ONE = 1;
@@ -130,12 +130,14 @@ module icebreaker_top #(
       .b_in  (enc_b),
       .a     (a),
       .b     (b),
-      .glitch(glitch)
+      .glitch(glitch),
+      .valid (cond_valid)
   );
 
+  // the decoder starts once the conditioner shows the real levels (its reference state)
   enc_x4_decoder u_x4 (
       .clk      (clk),
-      .rst      (rst),
+      .rst      (rst | ~cond_valid),
       .a        (a),
       .b        (b),
       .cnt_pulse(cnt4),

@@ -111,6 +111,7 @@ class ConditionerModel:
         self.level = [0, 0]
         self.run = [0, 0]  # consecutive samples of the other level seen so far
         self.glitch = 0
+        self.clocks = 0  # clocks since reset
 
     def clock(self, a_in: int, b_in: int) -> dict:
         """Advance one clock with the inputs as sampled at this edge; return the outputs after it."""
@@ -127,7 +128,9 @@ class ConditionerModel:
                 reject = True
         self.glitch = int(reject)
         self.pipe = [(a_in, b_in), self.pipe[0]]
-        return {"a": self.level[0], "b": self.level[1], "glitch": self.glitch}
+        self.clocks += 1
+        return {"a": self.level[0], "b": self.level[1], "glitch": self.glitch,
+                "valid": int(self.clocks >= self.f + 2)}
 
 
 def two_x_count(p: int) -> int:

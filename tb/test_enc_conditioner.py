@@ -40,10 +40,10 @@ class Checker:
             await ReadOnly()
             if rst:
                 self.model.reset()
-                exp = {"a": 0, "b": 0, "glitch": 0}
+                exp = {"a": 0, "b": 0, "glitch": 0, "valid": 0}
             else:
                 exp = self.model.clock(a_in, b_in)
-            got = {k: int(getattr(dut, k).value) for k in ("a", "b", "glitch")}
+            got = {k: int(getattr(dut, k).value) for k in ("a", "b", "glitch", "valid")}
             assert got == exp, f"clock {self.clocks}: got {got}, model {exp}"
             self.clocks += 1
             self.glitches += got["glitch"]

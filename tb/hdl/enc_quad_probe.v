@@ -25,6 +25,8 @@ module enc_quad_probe #(
 );
 
   wire glitch;
+  wire valid;
+  wire dec_rst = rst | ~valid;  // decoders start from the real state, once the conditioner settled
   wire cnt4, up4, err4;
   wire cnt2, up2, err2;
   wire up1, dn1, err1;
@@ -38,12 +40,13 @@ module enc_quad_probe #(
       .b_in  (b_in),
       .a     (a),
       .b     (b),
-      .glitch(glitch)
+      .glitch(glitch),
+      .valid (valid)
   );
 
   enc_x4_decoder u_x4 (
       .clk      (clk),
-      .rst      (rst),
+      .rst      (dec_rst),
       .a        (a),
       .b        (b),
       .cnt_pulse(cnt4),
@@ -53,7 +56,7 @@ module enc_quad_probe #(
 
   enc_x2_xor u_x2 (
       .clk      (clk),
-      .rst      (rst),
+      .rst      (dec_rst),
       .a        (a),
       .b        (b),
       .cnt_pulse(cnt2),
@@ -63,7 +66,7 @@ module enc_quad_probe #(
 
   enc_x1_hysteresis u_x1 (
       .clk     (clk),
-      .rst     (rst),
+      .rst     (dec_rst),
       .a       (a),
       .b       (b),
       .up_pulse(up1),
