@@ -10,7 +10,9 @@
 // One cnt_pulse per transition of A, up = A ^ B; a change of B alone gives none. The first sample
 // after rst is the reference. Extra output `error` (not in Figure 15): both channels changed
 // between two samples, so the direction of that A edge is unknown and the count may be wrong.
-// Outputs are registered: latency 1 clock from the a/b sample.
+// Outputs are registered: latency 1 clock from the a/b sample. `up` is the XOR itself, sampled
+// every clock: it gives the direction in the clock cnt_pulse is 1 (the U/D of the 74LS168 only
+// matters while it counts) and is not held between counts.
 `default_nettype none
 
 module enc_x2_xor (
@@ -19,7 +21,7 @@ module enc_x2_xor (
     input  wire a,          // channel A, synchronous to clk
     input  wire b,          // channel B, synchronous to clk
     output wire cnt_pulse,  // one clock per transition of A
-    output wire up,         // direction: A ^ B at the edge, 1 = forward
+    output wire up,         // direction (valid with cnt_pulse): A ^ B at the edge, 1 = forward
     output wire error       // one clock when A and B changed together (count direction unknown)
 );
 
@@ -46,7 +48,7 @@ module enc_x2_xor (
       b_prev_q <= b;
       ref_q    <= 1'b1;
       cnt_q    <= a_edge;
-      up_q     <= a_edge ? (a ^ b) : up_q;
+      up_q     <= a ^ b;
       error_q  <= a_edge & b_edge;
     end
   end

@@ -8,7 +8,9 @@
 //   forward (A leads B): 00 -> 10 -> 11 -> 01 -> 00, so next_fwd({a, b}) = {~b, a}
 // One cnt_pulse per valid transition (4 counts per cycle), up = 1 forward. An illegal transition
 // gives one `error` pulse and no count. The first sample after rst is the reference state and
-// is not counted. Outputs are registered: latency 1 clock from the a/b sample.
+// is not counted. Outputs are registered: latency 1 clock from the a/b sample. `up` is the
+// direction of the count in the clock cnt_pulse is 1 (like the U/D pin of a 74LS168, it only
+// matters while counting; between counts it is not held).
 `default_nettype none
 
 module enc_x4_decoder (
@@ -17,22 +19,21 @@ module enc_x4_decoder (
     input  wire a,          // channel A, synchronous to clk (from enc_conditioner)
     input  wire b,          // channel B, synchronous to clk
     output wire cnt_pulse,  // one clock per valid transition
-    output wire up,         // direction of the count: 1 = forward (A leads)
+    output wire up,         // direction of this count (valid with cnt_pulse): 1 = forward
     output wire error       // one clock per illegal transition (both channels changed)
 );
 
-  reg  [1:0] prev_q;   // {a, b} at the previous sample
-  reg        ref_q;    // prev_q holds a real sample (cleared by rst)
+  reg  [1:0] prev_q;  // {a, b} at the previous sample
+  reg        ref_q;   // prev_q holds a real sample (cleared by rst)
   reg        cnt_q;
   reg        up_q;
   reg        error_q;
 
-  wire [1:0] cur = {a, b};
-  wire [1:0] next_fwd_of_prev = {~prev_q[0], prev_q[1]};  // the look-up table
-  wire [1:0] next_fwd_of_cur = {~cur[0], cur[1]};
-  wire       fwd = (cur == next_fwd_of_prev);
-  wire       rev = (prev_q == next_fwd_of_cur);
-  wire       moved = (cur != prev_q);
+  // Which channels changed since the previous sample. Exactly one: a valid transition; both: an
+  // illegal one. For a valid transition the look-up "present == next_fwd(previous)" reduces to
+  // a == ~prev_b (with b == prev_a implied), so the direction is a ^ prev_b.
+  wire       a_moved = a ^ prev_q[1];
+  wire       b_moved = b ^ prev_q[0];
 
   always @(posedge clk) begin
     if (rst) begin
@@ -42,11 +43,11 @@ module enc_x4_decoder (
       up_q    <= 1'b0;
       error_q <= 1'b0;
     end else begin
-      prev_q  <= cur;
+      prev_q  <= {a, b};
       ref_q   <= 1'b1;
-      cnt_q   <= ref_q & (fwd | rev);
-      up_q    <= (ref_q & (fwd | rev)) ? fwd : up_q;
-      error_q <= ref_q & moved & ~fwd & ~rev;
+      cnt_q   <= ref_q & (a_moved ^ b_moved);
+      up_q    <= a ^ prev_q[0];
+      error_q <= ref_q & a_moved & b_moved;
     end
   end
 

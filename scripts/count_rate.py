@@ -52,7 +52,7 @@ def run_points(f: int, points: list[dict]) -> list[dict]:
         out = Path(tmp) / "results.json"
         run("enc_quad_probe", "test_count_rate", name=f"count_rate_bench_f{f}",
             parameters={"FILTER_LEN": f}, tb_sources=("enc_quad_probe.v",), testcase="sweep",
-            extra_env={"ENC_POINTS": json.dumps(points), "ENC_RESULTS": str(out)})
+            extra_env={"ENC_POINTS": json.dumps(points), "ENC_RESULTS": str(out)}, quiet=True)
         return json.loads(out.read_text())
 
 

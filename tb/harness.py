@@ -76,8 +76,11 @@ def run(
     tb_sources: tuple[str, ...] = (),
     testcase: str | None = None,
     extra_env: dict | None = None,
+    quiet: bool = False,
 ) -> None:
-    """Build ``toplevel`` and run the cocotb tests in ``test_module`` (a module in tb/)."""
+    """Build ``toplevel`` and run the cocotb tests in ``test_module`` (a module in tb/).
+    With ``quiet``, the simulator's output goes to build.log / test.log in the build directory
+    instead of the terminal (for scripts that print their own progress)."""
     sim = sim_name()
     build_dir = SIM_DIR / "build" / sim / name
     build_dir.mkdir(parents=True, exist_ok=True)
@@ -109,6 +112,7 @@ def run(
         timescale=("1ns", "1ps"),
         waves=waves and sim == "verilator",
         always=True,
+        log_file=build_dir / "build.log" if quiet else None,
     )
     env = {"PYTHONPATH": os.pathsep.join([str(TB), os.environ.get("PYTHONPATH", "")])}
     env.update(extra_env or {})
@@ -123,6 +127,7 @@ def run(
         seed=seed,
         waves=waves and sim == "verilator",
         test_dir=build_dir,
+        log_file=build_dir / "test.log" if quiet else None,
     )
     if waves and sim == "verilator":
         produced = build_dir / "dump.vcd"

@@ -42,6 +42,8 @@ async def run_walk(dut, rng, n, s_clocks, p_reverse=0.3) -> dict:
     """Reset, settle, play n transitions with states uniform[S, 2S] clocks; return what the
     decoders counted and what the shaft did."""
     f = int(dut.FILTER_LEN.value)
+    dut.a_in.value = 0  # the walk starts in state 00: be there before the decoders take their
+    dut.b_in.value = 0  # reference state (FILTER_LEN + 2 clocks after rst)
     await reset_dut(dut)
     await Timer((f + 4) * PERIOD_PS, unit="ps")
     wf = random_walk(rng, n, s_clocks * T_NS, 2 * s_clocks * T_NS, p_reverse=p_reverse)

@@ -88,6 +88,9 @@ async def play_samples(dut, s: Samples, model=None, bound=None):
                 exp = {nm: 0 for nm in names}
             else:
                 exp = model.step(a, b)
+            if exp.get("cnt_pulse") == 0:  # `up` is the direction of a count: only then defined
+                got.pop("up")
+                exp = {k: v for k, v in exp.items() if k != "up"}
             assert got == exp, f"clock {i}: pos {s.pos[i]} ab={a}{b}: got {got}, expected {exp}"
         if in_reset:
             p0, n = s.pos[i], 0
