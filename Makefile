@@ -9,6 +9,9 @@ SIM        ?= icarus
 JOBS       ?= 2
 WAVES      ?= 0
 SEED       ?=
+RPM        ?=
+TEMP_C     ?=
+CLK_HZ     ?=
 
 # scripts/bin holds our Verilator shim; it must come before any system verilator.
 export PATH := $(CURDIR)/scripts/bin:$(CURDIR)/$(VENV)/bin:$(PATH)
@@ -19,7 +22,7 @@ unexport WAVES
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv test lint clean synth bitstream
+.PHONY: help venv demo waves test lint clean synth bitstream
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -31,6 +34,12 @@ $(STAMP): requirements.txt scripts/bootstrap.sh
 	@bash scripts/bootstrap.sh
 
 venv: $(STAMP) ## create .venv from requirements.txt (done automatically by every target)
+
+demo: $(STAMP) ## the main job: a modeled HEDS-5000 drives every circuit (RPM= TEMP_C= CLK_HZ= SEED=)
+	@$(PY) scripts/demo.py --rpm "$(RPM)" --temp-c "$(TEMP_C)" --clk-hz "$(CLK_HZ)" --seed "$(SEED)"
+
+waves: $(STAMP) ## open the demo's sim/waves/demo.vcd in GTKWave with sim/demo.gtkw (or say how)
+	@$(PY) scripts/demo.py --waves
 
 test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilator; WAVES=1 for VCDs)
 	@case "$(SIM)" in icarus|verilator) ;; *) echo "make test: SIM=$(SIM) is not supported; use SIM=icarus or SIM=verilator" >&2; exit 2;; esac
