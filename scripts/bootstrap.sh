@@ -15,7 +15,10 @@ python3 -c 'import venv, ensurepip' >/dev/null 2>&1 || need_pkgs+=(python3-venv)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     echo "bootstrap: installing ${need_pkgs[*]} with apt-get"
-    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_pkgs[@]}" >/dev/null
+    if ! { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_pkgs[@]}"; } >/tmp/bootstrap-apt.log 2>&1; then
+      echo "bootstrap: apt-get could not install ${need_pkgs[*]} (see /tmp/bootstrap-apt.log); install them and run again" >&2
+      exit 1
+    fi
   else
     echo "bootstrap: missing system packages: ${need_pkgs[*]} (install them, e.g. 'sudo apt-get install ${need_pkgs[*]}')" >&2
     exit 1
