@@ -58,3 +58,4 @@ bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
 
 clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
 	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__
+	@echo "(kept .venv and the compiler cache .cache/; remove them by hand for a full reset)"
