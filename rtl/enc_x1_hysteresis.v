@@ -21,6 +21,8 @@
 // Extra output `error` (not in Figure 14): both channels changed between two samples; d is not
 // moved (the direction is unknown), so the position tracked from then on may be off by two.
 // The first sample after rst is the reference. Outputs are registered: latency 1 clock.
+// Implementation: d is held as s = d mod 4 (a 2-bit Gray up/down count of valid transitions,
+// no adder) plus one-hot flags for d = 3 and d = -1 (the latch bit of the ambiguous state).
 `default_nettype none
 
 module enc_x1_hysteresis (
@@ -34,52 +36,42 @@ module enc_x1_hysteresis (
 );
 
   reg  [1:0] prev_q;   // {a, b} at the previous sample
-  reg        ref_q;    // prev_q holds a real sample
-  reg  [2:0] d_q;      // d = p - 4n, two's complement, -1 .. 3
-  reg  [2:0] d_d;
+  reg        nref_q;   // 1 in the clock after rst: prev_q holds no real sample yet
+  reg  [1:0] s_q;      // s = d mod 4 = position of prev_q relative to R, Gray: 0 1 3 2 = 00 01 11 10
+  reg        top_q;    // d = 3  (s = 3, entered forward): the next forward transition fires up
+  reg        bot_q;    // d = -1 (s = 3, entered in reverse): the next reverse transition fires down
   reg        up_q;
   reg        dn_q;
   reg        error_q;
 
-  localparam [2:0] D_MINUS1 = 3'b111;
-  localparam [2:0] D_TOP = 3'd3;
-
-  wire [1:0] cur = {a, b};
-  wire       fwd = ref_q & (cur == {~prev_q[0], prev_q[1]});  // forward: next state {~b, a}
-  wire       rev = ref_q & (prev_q == {~cur[0], cur[1]});
-  wire       bad = ref_q & (cur != prev_q) & ~fwd & ~rev;
-  wire       fire_up = fwd & (d_q == D_TOP);
-  wire       fire_dn = rev & (d_q == D_MINUS1);
-
-  always @(*) begin
-    d_d = d_q;
-    if (fire_up) begin
-      d_d = 3'd0;
-    end else if (fire_dn) begin
-      d_d = 3'd2;
-    end else if (fwd) begin
-      d_d = d_q + 3'd1;
-    end else if (rev) begin
-      d_d = d_q - 3'd1;
-    end
-  end
+  // d is kept as s (two bits) plus the two one-hot flags for its ambiguous value (s = 3 is d = 3
+  // or d = -1); no adder. Like enc_x4_decoder: a valid transition changes exactly one channel,
+  // and its direction is a ^ prev_b (forward: next state {~b, a}).
+  wire a_moved = a ^ prev_q[1];
+  wire b_moved = b ^ prev_q[0];
+  wire moved   = a_moved ^ b_moved;         // one channel changed (no reference check)
+  wire dir     = a ^ prev_q[0];             // direction of that transition, 1 = forward
+  wire step    = moved & ~nref_q;           // valid transition: d moves
+  // top_q/bot_q are 0 in the first clock after rst, so the pulses need no reference check.
+  wire no_up   = rst | ~(dir & top_q);      // up_q: D = moved, this as its synchronous reset
+  wire no_dn   = rst | ~(~dir & bot_q);
 
   always @(posedge clk) begin
+    nref_q <= rst;
+    prev_q <= {a, b};
     if (rst) begin
-      prev_q  <= 2'b00;
-      ref_q   <= 1'b0;
-      d_q     <= 3'd0;
-      up_q    <= 1'b0;
-      dn_q    <= 1'b0;
-      error_q <= 1'b0;
-    end else begin
-      prev_q  <= cur;
-      ref_q   <= 1'b1;
-      d_q     <= d_d;
-      up_q    <= fire_up;
-      dn_q    <= fire_dn;
-      error_q <= bad;
+      s_q   <= 2'b00;
+      top_q <= 1'b0;
+      bot_q <= 1'b0;
+    end else if (step) begin
+      // Gray up/down: forward 00 -> 01 -> 11 -> 10 -> 00 (3 -> 0 is the up pulse, d = 0)
+      s_q   <= dir ? {s_q[0], ~s_q[1]} : {~s_q[0], s_q[1]};
+      top_q <= dir & (s_q == 2'b11);        // forward from d = 2
+      bot_q <= ~dir & (s_q == 2'b00);       // reverse from d = 0
     end
+    up_q    <= no_up ? 1'b0 : moved;
+    dn_q    <= no_dn ? 1'b0 : moved;
+    error_q <= rst ? 1'b0 : ~nref_q & ~moved & a_moved;  // both channels changed
   end
 
   assign up_pulse = up_q;

@@ -27,30 +27,25 @@ module enc_x2_xor (
 
   reg a_prev_q;
   reg b_prev_q;
-  reg ref_q;    // the previous-sample registers hold a real sample
+  reg nref_q;   // 1 in the clock after rst: the previous-sample registers hold no real sample
   reg cnt_q;
   reg up_q;
   reg error_q;
 
-  wire a_edge = ref_q & (a != a_prev_q);
-  wire b_edge = ref_q & (b != b_prev_q);
+  // Mapping notes (iCE40): the reference flag is kept inverted so that its D input is rst itself
+  // (no LUT); rst is folded into the A-edge term, so cnt_q needs no reset of its own; error_q
+  // takes the A-edge term as D and "B unchanged" as its synchronous reset (error = a_edge &
+  // b changed, and rst clears it through a_edge). Three LUTs: a_edge, b_same, a ^ b.
+  wire a_edge = ~rst & ~nref_q & (a ^ a_prev_q);
+  wire b_same = (b == b_prev_q);
 
   always @(posedge clk) begin
-    if (rst) begin
-      a_prev_q <= 1'b0;
-      b_prev_q <= 1'b0;
-      ref_q    <= 1'b0;
-      cnt_q    <= 1'b0;
-      up_q     <= 1'b0;
-      error_q  <= 1'b0;
-    end else begin
-      a_prev_q <= a;
-      b_prev_q <= b;
-      ref_q    <= 1'b1;
-      cnt_q    <= a_edge;
-      up_q     <= a ^ b;
-      error_q  <= a_edge & b_edge;
-    end
+    nref_q   <= rst;
+    a_prev_q <= a;
+    b_prev_q <= b;
+    cnt_q    <= a_edge;
+    up_q     <= rst ? 1'b0 : (a ^ b);
+    error_q  <= b_same ? 1'b0 : a_edge;
   end
 
   assign cnt_pulse = cnt_q;
