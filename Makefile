@@ -22,7 +22,7 @@ unexport WAVES
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream
+.PHONY: help venv demo waves test lint clean synth bitstream sweep
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -46,6 +46,10 @@ test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilato
 	@case "$(WAVES)" in 0|1) ;; *) echo "make test: WAVES=$(WAVES) must be 0 or 1" >&2; exit 2;; esac
 	@case "$(SEED)" in ""|*[!0-9]*) [ -z "$(SEED)" ] || { echo "make test: SEED=$(SEED) must be a non-negative integer" >&2; exit 2; };; esac
 	$(PY) -m pytest -n $(JOBS) tb
+
+# make sweep runs on Verilator (much faster for long runs) unless SIM is given on the command line.
+sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase error x frequency); sim/sweep_results.md + plot
+	$(PY) scripts/sweep.py --sim $(if $(filter file,$(origin SIM)),verilator,$(SIM)) --jobs $(JOBS)
 
 lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
 	@bash scripts/lint.sh
