@@ -18,7 +18,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from cocotb_tools.runner import Icarus, get_runner
+from cocotb_tools.runner import Icarus, get_results, get_runner
 
 TOP = Path(__file__).resolve().parent.parent
 RTL = TOP / "rtl"
@@ -127,7 +127,7 @@ def run(
     env = {"PYTHONPATH": os.pathsep.join([str(TB), os.environ.get("PYTHONPATH", "")])}
     env.update(extra_env or {})
     seed = os.environ.get("SEED") or None
-    runner.test(
+    results = runner.test(
         hdl_toplevel=toplevel,
         test_module=test_module,
         testcase=testcase,
@@ -139,6 +139,11 @@ def run(
         test_dir=build_dir,
         log_file=build_dir / "test.log" if quiet else None,
     )
+    # Under pytest the runner itself fails the test; from a script, fail here instead.
+    tests, failed = get_results(results)
+    if failed or not tests:
+        log = f" (log: {build_dir / 'test.log'})" if quiet else ""
+        raise RuntimeError(f"{name}: {failed} of {tests} cocotb tests failed{log}")
     if waves and sim == "verilator":
         produced = build_dir / "dump.vcd"
         if produced.exists():

@@ -134,7 +134,8 @@ async def start_clock(clk, period_ps: int) -> None:
     now = get_sim_time("ps")
     if now % period_ps:
         await Timer(period_ps - now % period_ps, unit="ps")
-    cocotb.start_soon(Clock(clk, period_ps, unit="ps").start())
+    # cocotb wants the high time given for an odd period (12 MHz = 83333 ps)
+    cocotb.start_soon(Clock(clk, period_ps, unit="ps", period_high=period_ps // 2).start())
 
 
 async def reset_dut(dut, clocks: int = 2) -> None:
