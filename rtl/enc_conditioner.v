@@ -106,17 +106,16 @@ module enc_conditioner #(
   endgenerate
 
   // ---- settling after reset: 2 synchronizer clocks + FILTER_LEN filter clocks ------------------
+  // A chain of SETTLE flip-flops filling with ones after rst: valid is its last stage. (A
+  // counter would need LUTs; these flip-flops need none.)
   localparam integer SETTLE = FILTER_LEN + 2;
-  reg [4:0] settle_q;  // clocks since rst, saturating at SETTLE (<= 18)
-  reg       valid_q;
+  reg [SETTLE-1:0] settle_q;
 
   always @(posedge clk) begin
     if (rst) begin
-      settle_q <= 5'd0;
-      valid_q  <= 1'b0;
-    end else if (!valid_q) begin
-      settle_q <= settle_q + 5'd1;
-      valid_q  <= (settle_q == SETTLE[4:0] - 5'd1);
+      settle_q <= {SETTLE{1'b0}};
+    end else begin
+      settle_q <= {settle_q[SETTLE-2:0], 1'b1};
     end
   end
 
@@ -133,7 +132,7 @@ module enc_conditioner #(
   assign a      = level[0];
   assign b      = level[1];
   assign glitch = glitch_q;
-  assign valid  = valid_q;
+  assign valid  = settle_q[SETTLE-1];
 
 endmodule
 
