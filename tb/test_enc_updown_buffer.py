@@ -200,6 +200,31 @@ async def reset_mid_motion(dut):
         pos = wf.final_position
 
 
+@cocotb.test()
+async def illegal_jumps_flagged(dut):
+    """Both channels flipping at the same instant (an illegal transition, two states at once):
+    every jump that moves A pulses `error`, so the count is never wrong silently."""
+    buf = await start(dut)
+    flags = FlagCounter(dut)
+    rng = random.Random(cocotb.RANDOM_SEED + 4)
+    hold_ns = 2.4 * buf.f * T_NS + 3 * T_NS  # long states: nothing else is rejected or missed
+    wf = walk([0], [0], start_pos=0)
+    t, pos, jumps = 0.0, 0, 0
+    for _ in range(24):
+        t += hold_ns * rng.uniform(1.0, 1.5)
+        if rng.random() < 0.5:
+            pos += rng.choice((1, -1))
+            wf.append(t, pos)
+        else:
+            pos += 2  # both channels change together
+            wf.append(t, pos)
+            jumps += 1
+    await play(dut, wf, clock_period_ps=PERIOD_PS)
+    await buf.settle()
+    assert jumps > 0 and flags.error == jumps, f"{flags.error} error pulses for {jumps} illegal jumps"
+    assert flags.glitch == 0
+
+
 CONFIGS = [  # (DIGITS, MODULUS, FILTER_LEN)
     (4, 10, 3),
     (4, 16, 1),
