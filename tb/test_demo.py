@@ -84,3 +84,9 @@ def test_short_demo_run(tmp_path):
     assert set(found) == {"a_in", "b_in", "x4_count", "bcd_count"}
     assert len(found["a_in"].changes) > 100
     assert png.stat().st_size > 10_000
+    # every signal the GTKWave save file shows exists in the dump
+    shown = [line.split()[-1].split("[")[0] for line in (TOP / "sim" / "demo.gtkw").read_text().splitlines()
+             if line.startswith("+") or (line[:1].isalpha() and "." in line)]
+    assert len(shown) > 20
+    found, _ = vcd_to_png.read_vcd(vcd, shown, t_end_ps=0)
+    assert sorted(set(shown) - set(found)) == [], "sim/demo.gtkw names signals the dump lacks"
