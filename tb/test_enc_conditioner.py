@@ -95,9 +95,17 @@ async def short_pulses_rejected(dut):
     wf.append(0.0, 0)
     t = 5 * T_NS
     sampled = 0
+
+    def near_sample(t_ns):  # within 1% of a clock period of a sampling edge: ambiguous, redraw
+        phase = ((t_ns - offset_ns) / T_NS) % 1.0
+        return phase < 0.01 or phase > 0.99
+
     for i in range(200):
-        width = rng.uniform(0.05, f - 1.05 if f > 1 else 0.95) * T_NS  # at most max(1, f-1) samples
-        start_t = t + rng.uniform(0, T_NS)
+        while True:
+            width = rng.uniform(0.05, f - 1.05 if f > 1 else 0.95) * T_NS  # <= max(1, f-1) samples
+            start_t = t + rng.uniform(0, T_NS)
+            if not (near_sample(start_t) or near_sample(start_t + width)):
+                break
         ab = (1, 0) if i % 2 else (0, 1)
         wf.append(start_t, 0, ab)
         wf.append(start_t + width, 0, (0, 0))
