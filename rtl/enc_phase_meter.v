@@ -50,6 +50,10 @@
 // Accuracy: the sampling error of each edge is below one clock and, with edges asynchronous to
 // clk, averages out over the cycles of a window; with >= 100 clocks per cycle and >= 64 cycles per
 // window the reading is within 0.25 degree of the true phase (the divider's floor adds < 1 LSB).
+// That needs the edges to fall at phases spread over the clock period. At a speed of exactly a
+// whole or half-whole number of clocks per cycle every edge is sampled at the same phase, the
+// sampling errors do not average out, and the error can reach about 2 clocks per cycle (3.6
+// degrees at 100 clocks per cycle); no single-clock sampler avoids this (test commensurate_speed).
 //
 // Inputs a and b must be synchronous to clk (from enc_conditioner, which also filters glitches).
 `default_nettype none
