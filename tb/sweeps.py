@@ -36,14 +36,13 @@ import random
 from dataclasses import asdict
 
 import cocotb
-from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
 from hedsmodel import EncoderUnit, Profile, budget, measure
 from models import two_x_count
-from quad import log_seed, play
+from quad import log_seed, play, reset_dut, start_clock
 
-CLK_PS = 83333                  # 12 MHz clock period, ps (odd: Clock gets period_high = 41666)
+CLK_PS = 83333                  # 12 MHz clock period, ps (odd: quad.start_clock handles it)
 CLK_NS = CLK_PS / 1000.0
 CLK_HZ = 1e12 / CLK_PS
 MARGIN = budget.COUNT_MARGIN    # the contract's 1.05
@@ -135,7 +134,7 @@ def filter_len(dut) -> int:
 
 async def start(dut) -> random.Random:
     """Start the 12 MHz clock, log the seed, return an RNG seeded from it."""
-    cocotb.start_soon(Clock(dut.clk, CLK_PS, unit="ps", period_high=CLK_PS // 2).start())
+    await start_clock(dut.clk, CLK_PS)
     seed = log_seed(dut)
     dut.rst.value = 1
     dut.a_in.value = 0
@@ -148,10 +147,7 @@ async def play_and_count(dut, wf, rng: random.Random) -> dict:
     """Reset the probe in state 00, play ``wf`` from a random clock phase, return the counts."""
     fl = filter_len(dut)
     dut.a_in.value, dut.b_in.value = wf.events[0][1], wf.events[0][2]
-    dut.rst.value = 1
-    for _ in range(2):
-        await FallingEdge(dut.clk)
-    dut.rst.value = 0
+    await reset_dut(dut)
     for _ in range(fl + 6):
         await FallingEdge(dut.clk)
     await Timer(rng.randrange(1, CLK_PS), unit="ps")

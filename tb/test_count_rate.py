@@ -26,11 +26,6 @@ PERIOD_PS = 10_000
 T_NS = PERIOD_PS / 1000
 
 
-def signed32(v) -> int:
-    v = int(v)
-    return v - (1 << 32) if v & (1 << 31) else v
-
-
 async def start(dut):
     await start_clock(dut.clk, PERIOD_PS)
     dut.a_in.value = 0
@@ -51,7 +46,7 @@ async def run_walk(dut, rng, n, s_clocks, p_reverse=0.3) -> dict:
     await Timer((f + 8) * PERIOD_PS, unit="ps")
     await FallingEdge(dut.clk)
     p = wf.final_position
-    r = {name: signed32(getattr(dut, name).value)
+    r = {name: getattr(dut, name).value.to_signed()
          for name in ("pos4", "pos2", "pos1", "n_err4", "n_err2", "n_err1", "n_glitch")}
     r.update(true4=p, true2=two_x_count(p) - two_x_count(0), s=s_clocks, n=n,
              min_state_clocks=wf.min_state_ns() / T_NS)
