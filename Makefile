@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # HEDS-5000 encoder-interface IP: build, test and demo entry points. `make help` lists them.
 # Every target bootstraps .venv from requirements.txt on first use (scripts/bootstrap.sh).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_characterizer -- the encoding characteristics of Figure 3 of the note, measured in logic.
 //
 // For every encoder cycle (rising edge of A to the next one) it measures, in clocks, the widths

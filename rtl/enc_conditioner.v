@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_conditioner -- input synchronizer and digital filter for the two encoder channels.
 //
 // Does in logic what the note asks of the 74LS14 Schmitt buffer in front of every counting

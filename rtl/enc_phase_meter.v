@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_phase_meter -- Figure 11 of the note, the averaging phase meter, in logic.
 //
 // The meter of Figure 11 low-pass filters the exclusive-OR of the two channels: the XOR is high

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_updown_buffer -- Figure 17, the 2X up/down buffer a microprocessor reads.
 //
 // Built as the figure builds it: the encoder channels go through the input conditioner (the

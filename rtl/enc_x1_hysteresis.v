@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_x1_hysteresis -- Figure 14, the cycle-count (1X) circuit with latched hysteresis.
 //
 // "The circuit depicted in Figure 14 provides an up or down pulse for every cycle. Due to the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_x2_xor -- Figure 15, the 2X count circuit: XOR edge detector.
 //
 // "The edge detection circuit shown in Figure 15 provides a pulse for each transition of channel

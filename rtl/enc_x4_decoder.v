@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // enc_x4_decoder -- 4X quadrature decode by look-up table, in hardware.
 //
 // The note's programmed-input decode (MICROPROCESSOR INTERFACE, DECODE ROUTINE): keep the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // icebreaker_top -- the encoder interface on a 1BitSquared iCEBreaker (iCE40UP5K-SG48, 12 MHz).
 //
 // A HEDS-5000 on PMOD1A drives the library's blocks side by side:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ls168 -- a 74LS168 (decade) / 74LS169 (binary) synchronous 4-bit up/down counter.
 //
 // The counter stage of the note's Figures 15 and 17 ("an Up/Down counter such as the 74LS168"),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // uart_tx -- 8N1 UART transmitter with a valid/ready byte input (board helper, not a contract
 // block; used by icebreaker_top to print the count on the iCEBreaker's FTDI serial port).
 //

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Create .venv from the pinned requirements.txt and make sure the system tools the flow needs
 # (Icarus Verilog, a C++ compiler and make for Verilator's model build) are present.
 # Missing system tools are installed with apt-get when running as root; otherwise a one-line

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Count-rate benchmark: the shortest state width (in clock periods) at which the conditioner +
 decoders still count exactly, for FILTER_LEN = 1..4, against the contract's bound max(1, F/2).
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """`make demo`: a modeled HEDS-5000 on a motor driving every circuit of the library at once.
 
 What it does:

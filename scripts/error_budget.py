@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """HEDS-5000 error-budget calculator: the application note's worked examples, inputs as flags.
 
 Subcommands (run with no flags, each reproduces the note's example):

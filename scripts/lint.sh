@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Lint every module in rtl/: Verilator --lint-only -Wall (with the reviewed waivers in
 # rtl/lint_waivers.vlt) and an Icarus -Wall build. Any warning fails the run.
 set -uo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Monte Carlo of a HEDS-5000 production batch: the state-width error distribution of Figure 7.
 
 Draws --units encoders from the note's Tables 2 and 3 (tb/hedsmodel), turns each through one

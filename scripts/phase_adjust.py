@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The technician's view of the phase adjustment (the note's Assembly Procedure, Figure 11).
 
 A modelled encoder is "adjusted": while the shaft runs forward at ~110 clocks per cycle, the

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Simulation speed: how fast the cocotb regression's typical load runs on each simulator.
 
 Plays the same random walk (N transitions, states of S..2S clocks, edges off the clock grid) into

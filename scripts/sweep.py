@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """The dense count-limit sweep (`make sweep`): frequency x FILTER_LEN 1..4 x phase error.
 
 For each FILTER_LEN (one build of tb/hdl/enc_quad_probe.v at the 12 MHz clock) the cocotb test

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """FPGA synthesis of every contract block and of the iCEBreaker board top (`make synth`).
 
 For each block at its default parameters: Yosys `synth_ice40`, then nextpnr-ice40 on an iCE40

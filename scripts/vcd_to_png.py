@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Render a short window of a VCD to a PNG, without GTKWave: a small VCD reader plus matplotlib.
 
     python scripts/vcd_to_png.py sim/waves/demo.vcd out.png --start-us 5000 --span-us 120 \

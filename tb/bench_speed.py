@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """cocotb side of scripts/sim_speed.py (not collected by pytest): play a fixed random walk into
 enc_quad_probe at 12 MHz and time it. Parameters from ENC_SPEED (JSON), results to ENC_RESULTS."""
 

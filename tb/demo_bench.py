@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The cocotb side of `make demo` (scripts/demo.py): plays the modeled HEDS-5000 waveform into
 tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/demo.py compares
 the records with the model and prints the table.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared cocotb runner glue for the regression.
 
 Every pytest test in tb/ calls :func:`run` to build one HDL toplevel with one parameter set and run

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Cycle-level Python reference models of the counting circuits, written from the module
 contracts and the note, not from the RTL.
 

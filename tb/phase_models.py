@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Parametric two-channel encoder waveforms and reference measurements for the phase meter and the
 characterizer tests (and scripts/phase_adjust.py).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Quadrature stimulus: waveforms as event lists, generators, and a cocotb driver.
 
 A waveform is a list of events ``(t_ns, a, b)``: from time ``t_ns`` (float, nanoseconds, relative to

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared logic of the counting-circuit sweeps (issue 4): tb/test_sweeps.py and scripts/sweep.py.
 
 A sweep *point* is one constant-speed run of one modelled HEDS-5000 unit (tb/hedsmodel) played

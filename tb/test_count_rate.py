@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Count-rate limit at the physical bound (contract of enc_conditioner + decoders).
 
 With FILTER_LEN = F and clock period T, counting must be exact whenever every state lasts at

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The synchronous decoders against their Python models, clock by clock:
 enc_x4_decoder (look-up-table 4X), enc_x2_xor (Figure 15), enc_x1_hysteresis (Figure 14).
 

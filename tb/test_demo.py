@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`make demo` (scripts/demo.py): its options are checked before anything is built, and a short
 run of the whole demo (every circuit from one modeled HEDS-5000) passes and leaves a VCD that
 scripts/vcd_to_png.py reads.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """enc_characterizer (the Figure 3 encoding characteristics) against measurements of the waveform.
 
 Two references, both computed from the waveform's event list and not from the RTL:

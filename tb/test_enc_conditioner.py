@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """enc_conditioner against its Python model, clock by clock, with edges off the clock grid.
 
 A monitor samples a_in/b_in at every rising edge (what the first synchronizer stage captures),

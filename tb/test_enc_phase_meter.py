@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """enc_phase_meter (Figure 11, the averaging phase meter) against the continuous waveform.
 
 The stimulus comes from tb/phase_models.py: waveforms computed from the shaft angle, edges at

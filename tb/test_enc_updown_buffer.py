@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """enc_updown_buffer (Figure 17) end to end: asynchronous A/B in, BCD or binary count out.
 
 The count must equal the true 2X position (transitions of A, signed) modulo MODULUS**DIGITS at

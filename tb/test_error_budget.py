@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """scripts/error_budget.py and hedsmodel.budget against every worked example of the application note.
 
 Plain pytest, no simulator. Each example is checked twice: through the functions and through the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The HEDS-5000 model (tb/hedsmodel): configured errors come back out of measure().
 
 Plain pytest, no simulator. Single error sources are configured one at a time and measured from

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The iCEBreaker board top (icebreaker_top) in simulation: encoder in, UART report line out.
 
 The top runs at its real 12 MHz clock with a fast UART (8 clocks per bit) and a report line every

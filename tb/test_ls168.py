@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """74LS168 / 74LS169 counter stage (ls168) against an independent Python model.
 
 Covers the whole function table: every state 0..15 (decade states 10..15 by load) crossed with every

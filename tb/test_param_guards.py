@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """An out-of-range parameter must stop elaboration with a message naming the parameter, on the
 simulator under test (SIM=icarus: iverilog; SIM=verilator: verilator). Yosys is covered by
 tb/test_param_guards_yosys.py. Every module is also elaborated at its good corners, so a guard

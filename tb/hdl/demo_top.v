@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test-only wrapper for `make demo`: every circuit of the library driven from one pair of encoder
 // channels, as the reader of the application note would wire them on one bench.
 //

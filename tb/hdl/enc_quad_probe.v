@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test-only wrapper: one enc_conditioner feeding all three decoders, with accumulators so a test
 // can play a long waveform and read the results at the end instead of watching every clock.
 //   pos4  signed net count of enc_x4_decoder (4X position)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test wrapper: three ls168 stages cascaded the way the data sheet (and Figure 17) does it:
 // ENP_n common, ENT_n of stage 0 is the count enable, RCO_n of each stage drives ENT_n of the next.
 `default_nettype none

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test-only: the naive 1X counter the note warns about (the multiple-count problem). It counts on
 // every rising edge of A, with B giving the direction, and has no hysteresis, so a shaft
 // dithering about A's rising edge counts up again and again. The hysteresis test must fail on it.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """hedsmodel: a behavioural model of one HP HEDS-5000 shaft encoder, after the application note.
 
 Public API (everything else is internal)::

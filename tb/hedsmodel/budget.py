@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The note's error-budget algebra, plus the decode-speed limit of this library's decoder.
 
 Each function returns a dict holding the JSON keys of the matching ``scripts/error_budget.py``

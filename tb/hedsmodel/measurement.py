@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Measure a quadrature waveform with the note's definitions (Figure 3).
 
 Works on any :class:`quad.Waveform` (from the model or not). The waveform is cut into monotone

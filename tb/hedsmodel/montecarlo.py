@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Monte Carlo batch for Figure 7: the distribution of the worst state-width error per unit.
 
 Each unit is drawn with :meth:`EncoderUnit.draw` (Tables 2 and 3, internal error), turned through

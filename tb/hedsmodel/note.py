@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Numbers from the HEDS-5000 application note, in one place.
 
 Lengths in mm, angles in electrical degrees (e°) unless a name says otherwise. Every table row is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Motion profiles: the shaft angle as a function of time, built from segments.
 
 A :class:`Profile` starts at ``start_deg`` (electrical degrees of shaft position; the default

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """One HEDS-5000 unit on its shaft: error sources -> A/B (and index) edge times.
 
 The model works in two steps.
