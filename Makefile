@@ -23,7 +23,7 @@ unexport WAVES
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -60,6 +60,18 @@ synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K) and the iCEBreaker top; t
 
 bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
 	$(PY) scripts/synth.py --only icebreaker_top --bitstream
+
+formal: $(STAMP) ## SymbiYosys proofs (k-induction) and covers of the counting circuits, one .sby per block
+	$(PY) scripts/formal.py --jobs $(JOBS)
+
+mutate: $(STAMP) ## mutation coverage: Yosys mutants of every RTL module against its tests (MUTATE_SEED=n)
+	$(PY) scripts/mutate.py --jobs $(JOBS) $(if $(MUTATE_SEED),--seed $(MUTATE_SEED))
+
+regs: $(STAMP) ## regenerate the enc_qei C header and register reference from rtl/enc_qei.rdl
+	$(PY) scripts/gen_regs.py
+
+velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 units through enc_qei
+	$(PY) scripts/velocity_bench.py --jobs $(JOBS)
 
 clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
 	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__
