@@ -46,7 +46,7 @@ test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilato
 	@case "$(SIM)" in icarus|verilator) ;; *) echo "make test: SIM=$(SIM) is not supported; use SIM=icarus or SIM=verilator" >&2; exit 2;; esac
 	@case "$(WAVES)" in 0|1) ;; *) echo "make test: WAVES=$(WAVES) must be 0 or 1" >&2; exit 2;; esac
 	@case "$(SEED)" in ""|*[!0-9]*) [ -z "$(SEED)" ] || { echo "make test: SEED=$(SEED) must be a non-negative integer" >&2; exit 2; };; esac
-	$(PY) -m pytest -n $(JOBS) tb
+	$(PY) -m pytest -n $(JOBS) tb boards python/tests
 
 # make sweep runs on Verilator (much faster for long runs) unless SIM is given on the command line.
 sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase error x frequency); sim/sweep_results.md + plot

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(TOP / "tb"))
+sys.path.insert(0, str(TOP / "tb" / "common"))  # the cocotb harness (the model is an installed package)
 
 RATIOS = (1.10, 1.07, 1.05, 1.03, 1.02, 1.01, 1.00, 0.99, 0.98, 0.97, 0.95, 0.92, 0.90)
 

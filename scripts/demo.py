@@ -47,7 +47,7 @@ from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
 TB = TOP / "tb"
-sys.path.insert(0, str(TB))
+sys.path.insert(0, str(TB / "common"))  # the cocotb harness (the model is an installed package)
 sys.path.insert(0, str(TOP / "scripts"))
 
 NAME = "demo"
@@ -329,20 +329,10 @@ def _progress(progress_file: Path, stop: threading.Event, tty: bool) -> None:
         print("\r" + " " * 88 + "\r", end="", flush=True)
 
 
-def _icarus_vcd_runner():
-    """cocotb's Icarus runner passes vvp '-none' when its own (FST) waves are off, which would
-    silence the $dumpfile of our dump module: ask for VCD instead (as tb/harness.py does)."""
-    from cocotb_tools.runner import Icarus
-
-    class IcarusVcd(Icarus):
-        def _test_command(self):
-            return [["-vcd" if a == "-none" else a for a in cmd] for cmd in super()._test_command()]
-
-    return IcarusVcd()
-
-
 def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
     from cocotb_tools.runner import get_runner
+
+    import harness  # the shared runner glue (sources, waivers, VCD-writing Icarus runner, PATH)
 
     logging.getLogger("cocotb").setLevel(logging.WARNING)
     build_dir = TOP / "sim" / "build" / sim / name
@@ -355,12 +345,12 @@ def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
     write_plan(plan, plan_file)
     params = {"FILTER_LEN": FILTER_LEN, "WINDOW_LOG2": plan.window_log2, "CNT_W": CHAR_CNT_W,
               "WINDOW_CYCLES": CHAR_CYCLES, "MIN_STATE": int(round(TEST_LIMIT_DEG * 256))}
-    sources = sorted((TOP / "rtl").glob("*.v")) + [TB / "hdl" / "demo_top.v"]
+    sources = harness.rtl_sources() + [harness.TB_HDL / "demo_top.v"]
     vcd.parent.mkdir(parents=True, exist_ok=True)
     vcd.unlink(missing_ok=True)
     if sim == "verilator":
         # trace demo_top's own signals only (every signal the review needs is one of them)
-        build_args = ["-j", "2", "-Wno-UNOPTFLAT", "-Wno-SPLITVAR", "--trace-depth", "1"]
+        build_args = ["-j", "2", str(harness.RTL / "lint_waivers.vlt"), "--trace-depth", "1"]
         plusargs, waves = [], True
     else:
         dump = build_dir / "demo_vcd_dump.v"
@@ -368,7 +358,7 @@ def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
                         f'    $dumpfile("{vcd}");\n    $dumpvars(1, demo_top);\n  end\nendmodule\n')
         sources.append(dump)
         build_args, plusargs, waves = ["-s", "demo_vcd_dump"], [], False
-    runner = _icarus_vcd_runner() if sim == "icarus" else get_runner(sim)
+    runner = harness.IcarusVcd() if sim == "icarus" else get_runner(sim)
     build_log, test_log = build_dir / "build.log", build_dir / "sim.log"
     t0 = time.monotonic()
     print(f"demo: building demo_top with {sim} (log: {build_log.relative_to(TOP)})", flush=True)
@@ -381,8 +371,7 @@ def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
             if build_log.exists() else ""
         raise SystemExit(f"demo: build failed ({exc}); last lines of {build_log}:\n{tail}")
     t_build = time.monotonic() - t0
-    env = {"PYTHONPATH": os.pathsep.join([str(TB), os.environ.get("PYTHONPATH", "")]),
-           "DEMO_PLAN": str(plan_file), "DEMO_RESULT": str(result_file),
+    env = {"DEMO_PLAN": str(plan_file), "DEMO_RESULT": str(result_file),
            "DEMO_PROGRESS": str(progress_file)}
     if sim == "icarus":
         env["COCOTB_RESOLVE_X"] = "ZEROS"
@@ -422,7 +411,7 @@ def a_edges(p: int) -> int:
 
 
 def _events_between(wf, i0: int, i1: int):
-    from quad import Waveform
+    from hedsmodel.waveform import Waveform
     return Waveform(events=wf.events[i0:i1 + 1], positions=wf.positions[i0:i1 + 1])
 
 

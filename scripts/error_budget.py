@@ -10,7 +10,7 @@ Subcommands (run with no flags, each reproduces the note's example):
   count-limit   fastest encoder this library's conditioner + decoder counts exactly (ours)
 
 Each prints a table, or with --json one JSON object. Invalid input exits with status 2 and one
-line on stderr. The maths lives in tb/hedsmodel/budget.py, shared with the tests.
+line on stderr. The maths lives in python/src/hedsmodel/budget.py, shared with the tests.
 """
 
 from __future__ import annotations
@@ -19,9 +19,7 @@ import argparse
 import json
 import math
 import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tb"))
 
 from hedsmodel import budget, note  # noqa: E402
 

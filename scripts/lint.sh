@@ -1,40 +1,43 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# Lint every module in rtl/: Verilator --lint-only -Wall (with the reviewed waivers in
-# rtl/lint_waivers.vlt) and an Icarus -Wall build. Any warning fails the run.
+# Lint every module of the IP and of the board: Verilator --lint-only -Wall (with the reviewed
+# waivers in rtl/lint_waivers.vlt) and an Icarus -Wall build, at the defaults and at every corner
+# of every ranged parameter. The file lists and ranges come from enc_ip.core (tb/common/core_file.py);
+# boards/icebreaker/lint_params.txt adds the board's combined corners. Any warning fails the run.
 set -uo pipefail
 cd "$(dirname "$0")/.."
-export PATH="$PWD/scripts/bin:$PATH"
+export PATH="$PWD/scripts/bin:$PWD/.venv/bin:$PATH"
+core() { .venv/bin/python tb/common/core_file.py "$@"; }
 
+mapfile -t ip_files < <(core files rtl)
+mapfile -t board_files < <(core files board_icebreaker)
 status=0
-waivers=()
-[ -f rtl/lint_waivers.vlt ] && waivers=(rtl/lint_waivers.vlt)
+checked=0
 
 # lint_one <module> [-GNAME=value ...]
 lint_one() {
   local top=$1; shift
-  local out ivparams=()
+  local out ivparams=() files=("${ip_files[@]}")
+  case " ${board_files[*]} " in *"/$top.v "*) files+=("${board_files[@]}");; esac
   for g in "$@"; do ivparams+=("-P$top.${g#-G}"); done
-  out=$(verilator --lint-only --quiet -Wall -Irtl "${waivers[@]}" --top-module "$top" "$@" rtl/*.v 2>&1)
+  out=$(verilator --lint-only --quiet -Wall rtl/lint_waivers.vlt --top-module "$top" "$@" "${files[@]}" 2>&1)
   if [ $? -ne 0 ] || [ -n "$out" ]; then
     echo "verilator: $top $*"; echo "$out"; status=1
   fi
-  out=$(iverilog -g2005 -Wall -o /dev/null -s "$top" "${ivparams[@]}" rtl/*.v 2>&1)
+  out=$(iverilog -g2005 -Wall -o /dev/null -s "$top" "${ivparams[@]}" "${files[@]}" 2>&1)
   if [ $? -ne 0 ] || [ -n "$out" ]; then
     echo "iverilog: $top $*"; echo "$out"; status=1
   fi
   checked=$((checked + 1))
 }
 
-checked=0
-for file in rtl/*.v; do
+for file in "${ip_files[@]}" "${board_files[@]}"; do
   lint_one "$(basename "$file" .v)"
 done
 while read -r top params; do
-  case "$top" in ''|'#'*) continue;; esac
   # shellcheck disable=SC2086
   lint_one "$top" $params
-done < rtl/lint_params.txt
+done < <(core corners; grep -v '^\s*\(#\|$\)' boards/icebreaker/lint_params.txt)
 if [ $status -eq 0 ]; then
   echo "lint: $checked module/parameter sets clean (verilator -Wall, iverilog -Wall)"
 else

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Monte Carlo of a HEDS-5000 production batch: the state-width error distribution of Figure 7.
 
-Draws --units encoders from the note's Tables 2 and 3 (tb/hedsmodel), turns each through one
+Draws --units encoders from the note's Tables 2 and 3 (the hedsmodel package, python/), turns each through one
 revolution, measures its worst state-width error from its own waveform, prints mean, sigma and
 the fraction under the 44 e° room-temperature limit (--limit) next to the note's algebraic
 prediction, and saves a histogram (default sim/figures/state_width_histogram.png). --rpm,
@@ -19,7 +19,6 @@ from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
 FIGURE = TOP / "sim" / "figures" / "state_width_histogram.png"
-sys.path.insert(0, str(TOP / "tb"))
 
 import numpy as np  # noqa: E402
 

@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(TOP / "tb"))
+sys.path.insert(0, str(TOP / "tb" / "common"))  # the cocotb harness (the model is an installed package)
 FIG = TOP / "sim" / "figures" / "phase_adjust.png"
 
 
@@ -36,9 +36,7 @@ def main() -> int:
     ap.add_argument("--out", type=Path, default=FIG, help="figure path")
     args = ap.parse_args()
     os.environ["SIM"] = args.sim
-    os.environ["PATH"] = os.pathsep.join([str(TOP / "scripts" / "bin"), str(Path(sys.executable).parent),
-                                          os.environ.get("PATH", "")])
-    from harness import run  # noqa: E402  (needs SIM and PATH)
+    from harness import run  # noqa: E402  (needs SIM; sets PATH)
 
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "phase_adjust.json"

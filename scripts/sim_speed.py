@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(TOP / "tb"))
+sys.path.insert(0, str(TOP / "tb" / "common"))  # the cocotb harness (the model is an installed package)
 
 
 def positive(kind):

@@ -3,7 +3,7 @@
 """The dense count-limit sweep (`make sweep`): frequency x FILTER_LEN 1..4 x phase error.
 
 For each FILTER_LEN (one build of tb/hdl/enc_quad_probe.v at the 12 MHz clock) the cocotb test
-`sweep_points` in tb/sweeps.py plays modelled HEDS-5000 units (tb/hedsmodel) into the counting
+`sweep_points` in tb/common/sweeps.py plays modelled HEDS-5000 units (the hedsmodel package, python/) into the counting
 circuits and compares the accumulated counts with the waveform's true position:
 
 - a grid: units with phase error 0 .. 70 e° (no other error, so the narrowest state is 90 - ΔS and
@@ -35,7 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(TOP / "tb"))
+sys.path.insert(0, str(TOP / "tb" / "common"))  # the cocotb harness (the model is an installed package)
 TABLE = TOP / "sim" / "sweep_results.md"
 RAW = TOP / "sim" / "build" / "sweep_raw.json"   # every point, for --replot (not committed)
 FIGURE = TOP / "sim" / "figures" / "count_limit.png"
@@ -238,8 +238,6 @@ def main(argv=None) -> int:
         print(args.table.read_text())
         return 1 if problems else 0
     os.environ["SIM"] = args.sim
-    os.environ["PATH"] = os.pathsep.join([str(TOP / "scripts" / "bin"), str(Path(sys.executable).parent),
-                                          os.environ.get("PATH", "")])
     fls = [int(x) for x in args.filter_lens.split(",")]
     print(f"sweep: {args.sim}, FILTER_LEN {fls}, {args.jobs} in parallel"
           f"{' (quick)' if args.quick else ''}; one line per simulated point", flush=True)

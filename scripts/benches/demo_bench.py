@@ -1,0 +1,191 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The cocotb side of `make demo` (scripts/demo.py): plays the modeled HEDS-5000 waveform into
+tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/demo.py compares
+the records with the model and prints the table.
+
+Environment (set by scripts/demo.py):
+  DEMO_PLAN      JSON: clk_ps, events [[t_ns, a, b]...], seg {name: [t0_ns, t1_ns]}, meas_rst_ns,
+                 hold_test_ns, hold_test_clocks, back_mid_ns
+  DEMO_RESULT    JSON written at the end (see ``result`` below)
+  DEMO_PROGRESS  a one-line file "<sim ns> <total ns> <segment>" rewritten as the run goes
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
+from cocotb.utils import get_sim_time
+
+from cocotbext.quadrature import play
+from hedsmodel.waveform import Waveform
+
+
+def _int(sig) -> int:
+    return int(sig.value)
+
+
+def _signed(sig) -> int:
+    return sig.value.to_signed()
+
+
+async def _until(t_ps: float) -> None:
+    now = get_sim_time("ps")
+    if t_ps > now:
+        await Timer(int(round(t_ps - now)), unit="ps")
+
+
+async def _record_rises(sig, out: list) -> None:
+    while True:
+        await RisingEdge(sig)
+        out.append(get_sim_time("ps"))
+
+
+async def _record_pm(dut, out: list) -> None:
+    while True:
+        await RisingEdge(dut.pm_valid)
+        await ReadOnly()
+        out.append({"t_ps": get_sim_time("ps"), "phase_err": _signed(dut.pm_phase_err),
+                    "a_leads": _int(dut.pm_a_leads), "b_leads": _int(dut.pm_b_leads)})
+
+
+async def _record_ch(dut, out: list) -> None:
+    while True:
+        await RisingEdge(dut.ch_valid)
+        await ReadOnly()
+        out.append({"t_ps": get_sim_time("ps"),
+                    **{k: _signed(getattr(dut, "ch_" + k))
+                       for k in ("cycle_err", "pulse_err", "phase_err", "state_err")},
+                    "state_min": _int(dut.ch_state_min), "pass": _int(dut.ch_pass)})
+
+
+async def _progress(path: str, t0_ps: float, total_ns: float, seg: dict) -> None:
+    step = total_ns / 100.0
+    t = 0.0
+    while True:
+        label = next((n for n, (a, b) in seg.items() if a <= t < b), "")
+        try:
+            with open(path, "w") as f:
+                f.write(f"{t:.0f} {total_ns:.0f} {label}\n")
+        except OSError:
+            pass
+        t += step
+        await _until(t0_ps + t * 1000.0)
+
+
+async def _snapshot(dut, t_ps: float, names) -> dict:
+    await _until(t_ps)
+    await ReadOnly()
+    return {n: _signed(getattr(dut, n)) if n.endswith("_count") and n.startswith("x")
+            else _int(getattr(dut, n)) for n in names}
+
+
+async def _pulse(dut, t_ps: float, sig_name: str, clk_ps: int) -> None:
+    await _until(t_ps)
+    await FallingEdge(dut.clk)
+    getattr(dut, sig_name).value = 1
+    await FallingEdge(dut.clk)
+    getattr(dut, sig_name).value = 0
+
+
+async def _hold_test(dut, t_ps: float, clocks: int, out: dict) -> None:
+    """Assert the buffer's read inhibit for `clocks` clocks: rd_data must not move while the
+    count does, and must catch up within 2 clocks of release."""
+    await _until(t_ps)
+    await FallingEdge(dut.clk)
+    dut.hold.value = 1
+    await RisingEdge(dut.clk)      # rd_data takes its last value on this edge at the latest
+    await FallingEdge(dut.clk)
+    rd0, c0 = _int(dut.bcd_rd), _int(dut.bcd_count)
+    frozen, moved = True, 0
+    prev = c0
+    for _ in range(clocks):
+        await FallingEdge(dut.clk)
+        if _int(dut.bcd_rd) != rd0:
+            frozen = False
+        c = _int(dut.bcd_count)
+        moved += c != prev
+        prev = c
+    dut.hold.value = 0
+    caught = False
+    for _ in range(2):
+        await FallingEdge(dut.clk)
+        if _int(dut.bcd_rd) == _int(dut.bcd_count):
+            caught = True
+            break
+    out.update(frozen=frozen, moved=moved, caught_up=caught, clocks=clocks)
+
+
+@cocotb.test()
+async def demo(dut):
+    plan = json.loads(open(os.environ["DEMO_PLAN"]).read())
+    clk_ps = int(plan["clk_ps"])
+    events = [tuple(e) for e in plan["events"]]
+    wf = Waveform(events=events, positions=[0] * len(events))
+    seg = plan["seg"]
+    total_ns = max(b for _, b in seg.values())
+
+    cocotb.start_soon(Clock(dut.clk, clk_ps, unit="ps").start())
+    dut.rst.value = 1
+    dut.meas_rst.value = 0
+    dut.hold.value = 0
+    dut.a_in.value = events[0][1]
+    dut.b_in.value = events[0][2]
+    for _ in range(4):
+        await FallingEdge(dut.clk)
+    dut.rst.value = 0
+    await Timer(clk_ps // 3, unit="ps")  # start the waveform off the clock grid
+    t0 = get_sim_time("ps")
+
+    a_rises, x1_up, x1_dn, x4_pulses = [], [], [], []
+    pm, ch = [], []
+    for coro in (_record_rises(dut.a, a_rises), _record_rises(dut.x1_up, x1_up),
+                 _record_rises(dut.x1_dn, x1_dn), _record_rises(dut.x4_pulse, x4_pulses),
+                 _record_pm(dut, pm), _record_ch(dut, ch)):
+        cocotb.start_soon(coro)
+    if os.environ.get("DEMO_PROGRESS"):
+        cocotb.start_soon(_progress(os.environ["DEMO_PROGRESS"], t0, total_ns, seg))
+    cocotb.start_soon(_pulse(dut, t0 + plan["meas_rst_ns"] * 1000, "meas_rst", clk_ps))
+    hold_test: dict = {}
+    cocotb.start_soon(_hold_test(dut, t0 + plan["hold_test_ns"] * 1000, plan["hold_test_clocks"],
+                                 hold_test))
+    names = ("x1_count", "x2_count", "x4_count", "pm_a_leads", "pm_b_leads")
+    snaps = {}
+
+    async def snap(key, t_ns):
+        snaps[key] = await _snapshot(dut, t0 + t_ns * 1000, names)
+
+    d0, d1 = seg["dither"]
+    h0, h1 = seg["hold"]
+    for key, t_ns in (("hold_end", h1 - 1000.0), ("back_mid", plan["back_mid_ns"]),
+                      ("dither_start", d0), ("dither_end", d1 + 20 * clk_ps / 1000)):
+        cocotb.start_soon(snap(key, t_ns))
+
+    await play(dut, wf, "a_in", "b_in")
+    await _until(t0 + (total_ns + 1000.0) * 1000)
+    for _ in range(50):
+        await FallingEdge(dut.clk)
+    await ReadOnly()
+    final = {n: (_signed(getattr(dut, n)) if n.startswith("x") else _int(getattr(dut, n)))
+             for n in ("x1_count", "x2_count", "x4_count", "bcd_count", "bcd_rd", "n_glitch",
+                       "n_x1_err", "n_x2_err", "n_x4_err", "n_bcd_flag")}
+    dps = (t0 + d0 * 1000, t0 + d1 * 1000 + 20 * clk_ps)
+    inside = lambda ts: [t for t in ts if dps[0] <= t <= dps[1]]
+    ds, de = snaps.get("dither_start", {}), snaps.get("dither_end", {})
+    result = {
+        "t0_ps": t0, "clk_ps": clk_ps, "final": final, "a_rises_ps": a_rises,
+        "pm_readings": pm, "ch_readings": ch, "hold_test": hold_test,
+        "leds": {"hold": [snaps["hold_end"]["pm_a_leads"], snaps["hold_end"]["pm_b_leads"]],
+                 "back": [snaps["back_mid"]["pm_a_leads"], snaps["back_mid"]["pm_b_leads"]]},
+        "dither": {"x4_pulses": len(inside(x4_pulses)),
+                   "x1_pulses": len(inside(x1_up)) + len(inside(x1_dn)),
+                   "x4_net": de["x4_count"] - ds["x4_count"],
+                   "x2_net": de["x2_count"] - ds["x2_count"],
+                   "x1_net": de["x1_count"] - ds["x1_count"]},
+        "snaps": snaps,
+    }
+    with open(os.environ["DEMO_RESULT"], "w") as f:
+        json.dump(result, f)

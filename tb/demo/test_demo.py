@@ -1,0 +1,92 @@
+# SPDX-License-Identifier: Apache-2.0
+"""`make demo` (scripts/demo.py): its options are checked before anything is built, and a short
+run of the whole demo (every circuit from one modeled HEDS-5000) passes and leaves a VCD that
+scripts/vcd_to_png.py reads.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import harness
+import pytest
+
+TOP = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(TOP / "scripts"))
+
+import demo  # noqa: E402  (scripts/demo.py; imports only the standard library at load time)
+
+
+@pytest.mark.parametrize("kwargs, fragment", [
+    ({"rpm": "fast"}, "is not a number"),
+    ({"rpm": "-600"}, "must be positive"),
+    ({"rpm": "0"}, "must be positive"),
+    ({"rpm": "nan"}, "must be finite"),
+    ({"rpm": "1e6"}, "above what the 4X decoder can count"),
+    ({"rpm": "58500"}, "above what the 4X decoder can count"),        # limit at 12 MHz: 58,412
+    ({"rpm": "6000", "temp_c": "125"}, "above what the 4X decoder can count"),  # 5,042 at 125 C
+    ({"rpm": "3000", "clk_hz": "3e5"}, "above what the 4X decoder can count"),
+    ({"rpm": "1"}, "runtime budget"),
+    ({"temp_c": "126"}, "outside"),
+    ({"temp_c": "-41"}, "outside"),
+    ({"temp_c": "warm"}, "is not a number"),
+    ({"clk_hz": "0"}, "must be positive"),
+    ({"clk_hz": "-12e6"}, "must be positive"),
+    ({"clk_hz": "1e12"}, "outside"),
+    ({"seed": "-1"}, "non-negative integer"),
+    ({"seed": "1.5"}, "non-negative integer"),
+    ({"seed": "x"}, "is not a number"),
+])
+def test_bad_option_rejected(kwargs, fragment):
+    with pytest.raises(demo.OptionError, match=fragment) as exc:
+        demo.validate(**kwargs)
+    assert "\n" not in str(exc.value)
+
+
+def test_defaults_and_good_values():
+    assert demo.validate() == demo.Options(3000.0, 25.0, 12e6, 1)
+    assert demo.validate("", "", "", "") == demo.Options(3000.0, 25.0, 12e6, 1)
+    o = demo.validate(rpm="8000", temp_c="-40", clk_hz="48e6", seed="7")
+    assert (o.rpm, o.temp_c, o.clk_hz, o.seed) == (8000.0, -40.0, 48e6, 7)
+    assert demo.validate(rpm="600").rpm == 600.0      # the note's 600 rpm example
+    # the decoder limit follows the clock: the same speed that fails at 300 kHz passes at 12 MHz
+    assert demo.validate(rpm="3000", clk_hz="12e6").rpm == 3000.0
+    assert 58_000 < demo.rpm_of(demo.f_max_hz(12e6, 25.0)) < 58_500
+
+
+def test_bad_option_fails_before_building():
+    """One line on stderr, exit status 2, nothing built."""
+    r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", "-5",
+                        "--name", "demo_badopt"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.count("\n") == 1 and "RPM=-5" in r.stderr, r.stderr
+    assert not (TOP / "sim" / "build" / "icarus" / "demo_badopt").exists()
+
+
+def test_short_demo_run(tmp_path):
+    """The whole demo at 20000 rpm (few clocks, Icarus): every verdict passes, the VCD parses."""
+    import vcd_to_png
+
+    env = dict(os.environ, PATH=harness.tool_env_path())
+    png = tmp_path / "waves.png"
+    r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", "20000",
+                        "--sim", "icarus", "--name", "demo_test", "--png", str(png)],
+                       capture_output=True, text=True, timeout=600, env=env, cwd=TOP)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "all circuits PASS" in r.stdout
+    assert r.stdout.count("  PASS  ") == 7
+    vcd = TOP / "sim" / "waves" / "demo_test.vcd"
+    assert vcd.stat().st_size < 50e6
+    found, _ = vcd_to_png.read_vcd(vcd, ["a_in", "b_in", "x4_count", "bcd_count"])
+    assert set(found) == {"a_in", "b_in", "x4_count", "bcd_count"}
+    assert len(found["a_in"].changes) > 100
+    assert png.stat().st_size > 10_000
+    # every signal the GTKWave save file shows exists in the dump
+    shown = [line.split()[-1].split("[")[0] for line in (TOP / "sim" / "demo.gtkw").read_text().splitlines()
+             if line.startswith("+") or (line[:1].isalpha() and "." in line)]
+    assert len(shown) > 20
+    found, _ = vcd_to_png.read_vcd(vcd, shown, t_end_ps=0)
+    assert sorted(set(shown) - set(found)) == [], "sim/demo.gtkw names signals the dump lacks"
