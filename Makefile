@@ -49,13 +49,13 @@ test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilato
 	$(PY) -m pytest -n $(JOBS) tb boards python/tests
 
 # make sweep runs on Verilator (much faster for long runs) unless SIM is given on the command line.
-sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase error x frequency); sim/sweep_results.md + plot
+sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase error x frequency); doc/results/sweep_results.md + plot
 	$(PY) scripts/sweep.py --sim $(if $(filter file,$(origin SIM)),verilator,$(SIM)) --jobs $(JOBS)
 
 lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
 	@bash scripts/lint.sh
 
-synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K) and the iCEBreaker top; table in sim/synth_results.md
+synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K) and the iCEBreaker top; table in doc/results/synth_results.md
 	$(PY) scripts/synth.py --jobs $(JOBS)
 
 bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin

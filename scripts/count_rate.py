@@ -8,7 +8,7 @@ clock grid, 30% reversals) for several seeds, at S = bound x ratio for ratios go
 1.10, and reports the smallest S at which every seed at that S and above was exact. Exact means
 the 4X and 2X counts equal the true position and the 1X count stays in its hysteresis band.
 Runs on Verilator by default (SIM=icarus also works, slower). Prints a progress line per point
-and a markdown table (also written to sim/count_rate.md).
+and a markdown table (also written to doc/results/count_rate.md).
 
     scripts/count_rate.py [--transitions 20000] [--seeds 3] [--filters 1 2 3 4]
 """
@@ -103,7 +103,7 @@ def main() -> int:
     note = (f"\n{args.seeds} seeds x {args.transitions:,} transitions per point, states uniform "
             f"[S, 2S] clock periods, edges off the clock grid, simulator {os.environ['SIM']}.\n")
     print(table + note)
-    (TOP / "sim" / "count_rate.md").write_text(table + "\n" + note)
+    (TOP / "doc" / "results" / "count_rate.md").write_text(table + "\n" + note)
     print("count_rate: every F within 5% of its bound" if ok else "count_rate: some F NOT within 5% of its bound")
     return 0 if ok else 1
 

@@ -15,7 +15,7 @@ circuits and compares the accumulated counts with the waveform's true position:
   prediction is scripts/error_budget.py count-limit with the unit's measured errors (and the same
   rule applied to the narrowest state and level directly; the smaller of the two is the limit).
 
-Writes sim/sweep_results.md (the table, included by the README) and sim/figures/count_limit.png
+Writes doc/results/sweep_results.md (the table, included by the README) and sim/figures/count_limit.png
 (exact / flagged points vs frequency, the predicted boundary, the measured one). Runs on
 Verilator by default (SIM=icarus works, about ten times slower). Prints one line per point.
 Usage: scripts/sweep.py [--sim icarus|verilator] [--jobs N] [--quick] [--seed N]
@@ -36,7 +36,7 @@ from pathlib import Path
 
 TOP = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(TOP / "tb" / "common"))  # the cocotb harness (the model is an installed package)
-TABLE = TOP / "sim" / "sweep_results.md"
+TABLE = TOP / "doc" / "results" / "sweep_results.md"
 RAW = TOP / "sim" / "build" / "sweep_raw.json"   # every point, for --replot (not committed)
 FIGURE = TOP / "sim" / "figures" / "count_limit.png"
 
@@ -107,7 +107,7 @@ def fmt_khz(f: float) -> str:
 
 
 def write_table(results: dict, sim: str, seconds: float, path: Path) -> list[str]:
-    """sim/sweep_results.md; returns the list of problems (silent losses, exactness failures)."""
+    """doc/results/sweep_results.md; returns the list of problems (silent losses, exactness failures)."""
     problems = []
     lines = [
         "<!-- written by scripts/sweep.py (make sweep); do not edit by hand -->",

