@@ -23,7 +23,7 @@ unexport WAVES
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -72,6 +72,9 @@ regs: $(STAMP) ## regenerate the enc_qei C header and register reference from rt
 
 velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 units through enc_qei
 	$(PY) scripts/velocity_bench.py --jobs $(JOBS)
+
+package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
+	@bash scripts/check_package.sh
 
 clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
 	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__
