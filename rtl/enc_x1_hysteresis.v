@@ -79,6 +79,84 @@ module enc_x1_hysteresis (
   assign dn_pulse = dn_q;
   assign error    = error_q;
 
+`ifdef FORMAL
+  // ---- formal only (formal/enc_x1_hysteresis.sby): invariants, asserts only --------------------
+  // A shadow of the header's d = p - 4n, kept from the ports alone (p: the 4X position of the
+  // valid transitions of a, b since rst, illegal changes ignored; n: #up_pulse - #dn_pulse since
+  // rst), is asserted to stay in -1 .. 3 (so |4n - p| <= 3) and to be what s_q / top_q / bot_q
+  // encode. And the dither property: once a pulse fired on a transition between two states X and
+  // Y, no pulse fires on a transition between X and Y until a valid transition between another
+  // pair (or an illegal change, or rst) ends the dither. These need the shadow (history), so they
+  // live here and not in the port-level wrapper: Yosys has no hierarchical references.
+  reg              f_rst_seen = 1'b0;  // a rst has happened: the RTL state is defined
+  reg        [1:0] f_cur;              // {a, b} sampled at the last clock (the RTL's prev_q)
+  reg              f_real;             // f_cur is a real sample, i.e. rst was low at that clock
+  reg signed [4:0] f_q;                // p - 4 * (n counted before this clock's outputs)
+  reg              f_t_valid;          // this clock's outputs belong to a valid transition ...
+  reg              f_t_illegal;        // ... or to an illegal change (both channels)
+  reg              f_t_fwd;            // ... and its direction
+  reg        [3:0] f_t_pair;           // one-hot {from, to} states of that transition
+  reg              f_blk;              // a dither is going on in which a pulse has fired ...
+  reg        [3:0] f_blk_pair;         // ... about this pair of states
+
+  wire       [1:0] f_ab = {a, b};
+  wire             f_a_ch = f_real & (a ^ f_cur[1]);
+  wire             f_b_ch = f_real & (b ^ f_cur[0]);
+  wire             f_step = f_a_ch ^ f_b_ch;                    // valid transition at this clock
+  wire             f_fwd = (f_ab == {~f_cur[0], f_cur[1]});   // forward: next {a, b} = {~b, a}
+  wire             f_pulse = up_pulse | dn_pulse;
+  wire signed [4:0] f_e = f_q - (up_pulse ? 5'sd4 : 5'sd0) + (dn_pulse ? 5'sd4 : 5'sd0);  // p - 4n
+  wire signed [4:0] f_d = (s_q == 2'b00) ? 5'sd0 : (s_q == 2'b01) ? 5'sd1 :
+                          (s_q == 2'b11) ? 5'sd2 : top_q ? 5'sd3 : -5'sd1;  // d as the RTL holds it
+  wire       [3:0] f_cur_hot = 4'b0001 << f_cur;
+  wire       [3:0] f_next_hot = 4'b0001 << {~f_cur[0], f_cur[1]};  // forward neighbour of f_cur
+  wire       [3:0] f_back_hot = 4'b0001 << {f_cur[0], ~f_cur[1]};  // reverse neighbour
+  // the dither state after this clock's transition and pulses
+  wire             f_blk_now = f_t_valid ? (f_pulse | (f_blk & (f_t_pair == f_blk_pair))) :
+                               (f_blk & ~f_t_illegal);
+  wire       [3:0] f_pair_now = (f_t_valid & f_pulse) ? f_t_pair : f_blk_pair;
+
+  always @(posedge clk) begin
+    f_cur <= f_ab;
+    f_real <= ~rst;
+    f_t_valid <= ~rst & f_step;
+    f_t_illegal <= ~rst & f_a_ch & f_b_ch;
+    f_t_fwd <= f_fwd;
+    f_t_pair <= f_cur_hot | (4'b0001 << f_ab);
+    if (rst) begin
+      f_rst_seen <= 1'b1;
+      f_q <= 5'sd0;
+      f_blk <= 1'b0;
+      f_blk_pair <= 4'b0000;
+    end else begin
+      f_q <= f_q + (f_step ? (f_fwd ? 5'sd1 : -5'sd1) : 5'sd0) - (up_pulse ? 5'sd4 : 5'sd0) +
+             (dn_pulse ? 5'sd4 : 5'sd0);
+      f_blk <= f_blk_now;
+      f_blk_pair <= f_pair_now;
+    end
+  end
+
+  always @(*) begin
+    if (f_rst_seen) begin
+      // |4n - p| <= 3, and d is what the header says it is
+      assert (f_e >= -5'sd1 && f_e <= 5'sd3);
+      assert (!(top_q && bot_q));
+      assert ((top_q | bot_q) == (s_q == 2'b10));
+      assert (f_d == f_e);
+      assert (prev_q == f_cur && nref_q == !f_real);
+      // pulses only on a valid transition, in its direction; never both
+      if (f_pulse) assert (f_t_valid && (up_pulse ? f_t_fwd : !f_t_fwd) && !(up_pulse && dn_pulse));
+      // dither about one transition: at most one pulse in total
+      assert (!(f_blk && f_t_valid && f_t_pair == f_blk_pair && f_pulse));
+      if (f_blk_now) begin
+        assert (f_pair_now == (f_cur_hot | f_next_hot) || f_pair_now == (f_cur_hot | f_back_hot));
+        if (f_pair_now == (f_cur_hot | f_next_hot)) assert (f_e != 5'sd3);  // forward won't fire
+        if (f_pair_now == (f_cur_hot | f_back_hot)) assert (f_e != -5'sd1);  // reverse won't fire
+      end
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

@@ -53,6 +53,23 @@ module enc_x2_xor (
   assign up        = up_q;
   assign error     = error_q;
 
+`ifdef FORMAL
+  // ---- formal only (formal/enc_x2_xor.sby): invariants, asserts only -----------------------------
+  // The port-level properties are in formal/enc_x2_xor_formal.v. These state invariants of the
+  // registers, so that a parent's induction (enc_updown_buffer) can use them.
+  reg f_rst_seen = 1'b0;  // a rst has happened: the registers are defined
+  always @(posedge clk) begin
+    if (rst) f_rst_seen <= 1'b1;
+  end
+
+  always @(*) begin
+    if (f_rst_seen) begin
+      if (nref_q) assert (!cnt_q && !up_q && !error_q);  // the clock after rst
+      if (error_q) assert (cnt_q);  // an error is an A edge with B changed too
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

@@ -56,6 +56,23 @@ module enc_x4_decoder (
   assign up        = up_q;
   assign error     = error_q;
 
+`ifdef FORMAL
+  // ---- formal only (formal/enc_x4_decoder.sby): invariants, asserts only -------------------------
+  // The port-level properties are in formal/enc_x4_decoder_formal.v. These state invariants of
+  // the registers, so that a parent's induction can use them.
+  reg f_rst_seen = 1'b0;  // a rst has happened: the registers are defined
+  always @(posedge clk) begin
+    if (rst) f_rst_seen <= 1'b1;
+  end
+
+  always @(*) begin
+    if (f_rst_seen) begin
+      if (!ref_q) assert (prev_q == 2'b00 && !cnt_q && !up_q && !error_q);  // the clock after rst
+      assert (!(cnt_q && error_q));
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

@@ -113,6 +113,16 @@ def check_tools() -> dict[str, str]:
     return tools
 
 
+def source_path(where: str) -> str:
+    """'x_formal.v:12.5-12.30' (sby's copy in src/) -> 'formal/x_formal.v:12' (the repo file)."""
+    name, _, pos = where.partition(":")
+    line = pos.split(".")[0]
+    for folder in ("formal", "rtl"):
+        if (TOP / folder / name).exists():
+            return f"{folder}/{name}:{line}"
+    return where
+
+
 def collect_details(t: Task, log_text: str) -> None:
     """Name the counterexample / cover traces and unreached covers of a failed task."""
     workdir = TOP / t.workdir_rel
@@ -129,13 +139,22 @@ def collect_details(t: Task, log_text: str) -> None:
             seen.add(rel)
             t.details.append(f"induction counterexample: {rel} (the start state may be "
                              f"unreachable: an invariant is missing)")
-    for m in re.finditer(r"failed (assertion|cover statement) (\S+) at (\S+)", log_text):
-        t.details.append(f"failed {m.group(1)} at {m.group(3)}")
-    for m in re.finditer(r"unreached cover statement (\S+) at (\S+)", log_text):
-        t.details.append(f"unreached cover at {m.group(2)}")
+    for line in log_text.splitlines():
+        m = (re.search(r"Assert failed in \S+: (\S+)", line) or
+             re.search(r"failed assertion \S+ at (\S+)", line))
+        if m:
+            note = f"failed assertion at {source_path(m.group(1))}"
+        else:
+            m = re.search(r"Unreached cover statement at \S+: (\S+)", line)
+            if not m:
+                continue
+            note = (f"unreached cover at {source_path(m.group(1))} (no trace reaches it "
+                    f"within the task's depth)")
+        if note not in t.details:
+            t.details.append(note)
     if not any(d.endswith(".vcd") or ".vcd " in d for d in t.details):
         vcds = sorted(workdir.glob("engine_*/trace*.vcd"))
-        if vcds and t.task.startswith("prove"):
+        if vcds and "cover" not in t.task:
             t.details.append("trace: " + ", ".join(str(v.relative_to(TOP)) for v in vcds))
     t.details.append(f"log: {t.workdir_rel / 'logfile.txt'}")
 
