@@ -27,7 +27,9 @@ segments: ``.constant(rpm, s)``, ``.ramp(rpm0, rpm1, s)``, ``.stop(s)``,
 
 Modules: :mod:`.note` (the note's numbers), :mod:`.budget` (its error-budget algebra, shared with
 ``scripts/error_budget.py``), :mod:`.profile`, :mod:`.unit` (the physics, described there),
-:mod:`.measurement`, :mod:`.montecarlo` (Figure 7 batch, used by ``scripts/monte_carlo.py``).
+:mod:`.measurement`, :mod:`.montecarlo` (Figure 7 batch, used by ``scripts/monte_carlo.py``),
+:mod:`.velocity` (host-side M, T and M/T velocity estimators for enc_qei snapshots, mirrored in C
+by ``sw/enc_qei_velocity.c``, and the snapshots an ideal peripheral latches from a waveform).
 Waveforms: :mod:`.waveform` (``Waveform``, ``walk``, ``random_walk``, ``with_glitches``, ``QUAD``,
 ``STATE_TO_POS``, ``state_of``) -- the event-list format every generator here produces and the
 cocotb driver in :mod:`cocotbext.quadrature` plays. Nothing in this package imports cocotb.
