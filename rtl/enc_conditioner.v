@@ -135,6 +135,25 @@ module enc_conditioner #(
   assign glitch = glitch_q;
   assign valid  = settle_q[SETTLE-1];
 
+`ifdef FORMAL
+  // ---- formal only (formal/enc_conditioner.sby): invariants, asserts only ----------------------
+  // The port-level properties are in formal/enc_conditioner_formal.v. These bound the registers
+  // to their reachable values, so that induction (here and in a parent) needs no long traces:
+  // each run-length counter stays in 0 .. FILTER_LEN-1 (it has spare codes unless FILTER_LEN is a
+  // power of two), and the settling chain fills with ones from bit 0 (a thermometer code).
+  reg f_rst_seen = 1'b0;  // a rst has happened: the registers are defined
+  always @(posedge clk) begin
+    if (rst) f_rst_seen <= 1'b1;
+  end
+
+  always @(*) begin
+    if (f_rst_seen) begin
+      assert (g_filter[0].run_q <= LAST && g_filter[1].run_q <= LAST);
+      assert (((settle_q >> 1) & ~settle_q) == {SETTLE{1'b0}});
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire

@@ -139,6 +139,10 @@ def collect_details(t: Task, log_text: str) -> None:
             seen.add(rel)
             t.details.append(f"induction counterexample: {rel} (the start state may be "
                              f"unreachable: an invariant is missing)")
+    errors = [line.split("ERROR:", 1)[1].strip() for line in log_text.splitlines()
+              if "ERROR:" in line]
+    for e in errors[:3]:
+        t.details.append(f"error: {e}")
     for line in log_text.splitlines():
         m = (re.search(r"Assert failed in \S+: (\S+)", line) or
              re.search(r"failed assertion \S+ at (\S+)", line))
