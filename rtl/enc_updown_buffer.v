@@ -128,6 +128,91 @@ module enc_updown_buffer #(
 
   assign rd_data = rd_q;
 
+`ifdef FORMAL
+  // ---- formal only (formal/enc_updown_buffer.sby): invariants, asserts only --------------------
+  // The count against a shadow position of the conditioned channels a, b (which the ports do not
+  // show, so this lives here), kept digit by digit modulo MODULUS**DIGITS: from the first sample
+  // the decoder takes as reference (after rst and the conditioner's settling) it moves +1 / -1
+  // per valid transition of A (B unchanged) in its 4X direction, and per A transition with B
+  // changed too (direction unknown) as Figure 15's XOR says, up = A ^ B. Asserted: count equals
+  // it at every clock, error pulses exactly for those illegal A transitions (so the count is the
+  // 2X position exactly unless error pulsed), every digit stays in 0 .. MODULUS-1, and rco_n is
+  // low exactly while a count wraps the whole counter.
+  localparam integer F_W = 4 * DIGITS;
+  localparam [3:0] F_MAX = MODULUS - 1;
+
+  // digits +1 (up) or -1 (down) modulo MODULUS**DIGITS, digit 0 least significant
+  function [F_W-1:0] f_step;
+    input [F_W-1:0] digits;
+    input up_dir;
+    integer k;
+    reg carry;
+    begin
+      f_step = digits;
+      carry  = 1'b1;
+      for (k = 0; k < DIGITS; k = k + 1) begin
+        if (carry) begin
+          if (up_dir) begin
+            if (digits[4*k+:4] == F_MAX) f_step[4*k+:4] = 4'd0;
+            else begin
+              f_step[4*k+:4] = digits[4*k+:4] + 4'd1;
+              carry = 1'b0;
+            end
+          end else begin
+            if (digits[4*k+:4] == 4'd0) f_step[4*k+:4] = F_MAX;
+            else begin
+              f_step[4*k+:4] = digits[4*k+:4] - 4'd1;
+              carry = 1'b0;
+            end
+          end
+        end
+      end
+    end
+  endfunction
+
+  wire [F_W-1:0] f_all_max = {DIGITS{F_MAX}};
+  wire           f_x2_rst = rst | ~cond_valid;
+
+  reg            f_rst_seen = 1'b0;
+  reg            f_pa;  // the conditioned A, B at the last clock
+  reg            f_pb;
+  reg            f_ref;  // the decoder took that sample (as its reference or counted it)
+  reg            f_illegal;  // the sample taken at the last clock was an A edge with B changed
+  reg  [F_W-1:0] f_pos;  // the shadow position, including the sample taken at the last clock
+  reg  [F_W-1:0] f_pos_q;  // ... one clock later (the count's latency)
+
+  wire           f_a_edge = ~f_x2_rst & f_ref & (a ^ f_pa);
+  wire           f_b_changed = (b != f_pb);
+  // forward valid A transition: {a, b} == {~prev b, prev a}; with B changed too: A ^ B
+  wire           f_dir = f_b_changed ? (a ^ b) : (a == ~f_pb);
+
+  always @(posedge clk) begin
+    f_pa <= a;
+    f_pb <= b;
+    f_ref <= ~f_x2_rst;
+    f_illegal <= f_a_edge & f_b_changed;
+    f_pos_q <= rst ? {F_W{1'b0}} : f_pos;
+    if (rst) begin
+      f_rst_seen <= 1'b1;
+      f_pos <= {F_W{1'b0}};
+    end else if (f_a_edge) begin
+      f_pos <= f_step(f_pos, f_dir);
+    end
+  end
+
+  integer f_k;
+  always @(*) begin
+    if (f_rst_seen) begin
+      for (f_k = 0; f_k < DIGITS; f_k = f_k + 1) begin
+        assert (count[4*f_k+:4] <= F_MAX && f_pos[4*f_k+:4] <= F_MAX);
+      end
+      assert (count == f_pos_q);
+      assert (error == f_illegal);
+      assert (rco_n == ~(cnt_pulse & (up ? (count == f_all_max) : (count == {F_W{1'b0}}))));
+    end
+  end
+`endif
+
 endmodule
 
 `default_nettype wire
