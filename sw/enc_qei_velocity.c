@@ -50,6 +50,7 @@ int qei_vel_init(qei_vel_t *st, const qei_vel_cfg_t *cfg)
         cfg->count_w > 64u || cfg->counts_per_edge < 1u)
         return -1;
     st->cfg = *cfg;
+    st->mt_ref = 1;
     return 0;
 }
 
@@ -60,7 +61,7 @@ qei_vel_reading_t qei_vel_update(qei_vel_t *st, const qei_vel_snap_t *s)
     qei_vel_snap_t p = st->prev;
     uint32_t dt, since;
     int64_t delta;
-    int stalled, new_edge;
+    int stalled, new_edge, cdir;
     double t_mag;
 
     st->prev = *s;
@@ -75,16 +76,25 @@ qei_vel_reading_t qei_vel_update(qei_vel_t *st, const qei_vel_snap_t *s)
     since = ts_diff(c, s->time, s->edge_time);
     stalled = s->stalled || (c->stall_ticks > 0u && since >= c->stall_ticks);
     new_edge = s->edge_delta != 0 || s->edge_time != p.edge_time;
+    cdir = sign_of(delta);
     /* M/T: timestamp */
+    if (cdir != 0 && st->mt_dir != 0 && cdir != st->mt_dir) {
+        st->mt_dir = cdir; /* the counts reversed: 0 until re-referenced */
+        st->mt_mag = 0.0;
+        st->mt_ref = 1;
+    }
     if (new_edge) {
         int d = sign_of(s->edge_delta);
-        if (d == 0) {
+        if (st->mt_ref || d == 0 || (st->mt_dir != 0 && d != st->mt_dir)) {
+            if (d != 0 && !st->mt_ref)
+                st->mt_dir = d; /* reversal rule: reads 0, new reference */
+            else if (st->mt_dir == 0)
+                st->mt_dir = d;
             st->mt_mag = 0.0;
+            st->mt_ref = 0;
         } else {
             uint32_t dte = ts_diff(c, s->edge_time, p.edge_time);
-            if (st->mt_dir != 0 && d != st->mt_dir)
-                st->mt_mag = 0.0; /* reversal rule */
-            else if (dte > 0u)
+            if (dte > 0u)
                 st->mt_mag = (double)(s->edge_delta < 0 ? -(int64_t)s->edge_delta
                                                         : (int64_t)s->edge_delta) /
                              ((double)dte * c->tick_s);
@@ -93,9 +103,13 @@ qei_vel_reading_t qei_vel_update(qei_vel_t *st, const qei_vel_snap_t *s)
     }
     r.mt = (double)st->mt_dir * bounded(c, st->mt_mag, new_edge, since, stalled);
     /* T: period */
-    if (delta != 0)
-        st->t_dir = sign_of(delta);
-    if (s->period == 0u || s->period_ovf || s->period_dir_change)
+    if (cdir != 0 && st->t_dir != 0 && cdir != st->t_dir)
+        st->t_hold = 1;
+    else if (new_edge)
+        st->t_hold = 0;
+    if (cdir != 0)
+        st->t_dir = cdir;
+    if (st->t_hold || s->period == 0u || s->period_ovf || s->period_dir_change)
         t_mag = 0.0;
     else
         t_mag = (double)(s->period_n > 1u ? s->period_n : 1u) * (double)c->counts_per_edge /

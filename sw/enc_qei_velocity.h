@@ -27,11 +27,17 @@
  *                    count arrives in a read period (below 30 rpm at 1 kHz reads on a
  *                    HEDS-5000, 500 cycles/rev, x4).
  *   T  (period):     period_n * cpe / period, in the direction of the last non-zero delta; 0
- *                    with no measurement, on overflow, or across a direction change.
+ *                    with no measurement, on overflow, across a direction change, and from a
+ *                    snapshot whose delta reverses the direction until the next new edge in a
+ *                    later snapshot.
  *   MT (timestamp, hostmot2): on a new edge, edge_delta / (edge_time - prev edge_time).
- *                    Reversal rule: a sign of edge_delta opposite to the last non-zero one reads
- *                    0 (the next reading is measured normally); edge_delta == 0 on a new edge
- *                    (there and back) reads 0.
+ *                    Reversal rule: a new edge whose edge_delta has the sign opposite to the
+ *                    last one reads 0 and becomes the new reference; so does a new edge with
+ *                    edge_delta == 0 (there and back). When delta goes against the last
+ *                    direction before a selected edge confirms it (A rising at low speed), the
+ *                    reading is 0 at once, the direction follows the counts and the next new
+ *                    edge is a reference only (its interval spans the reversal). The first new
+ *                    edge after qei_vel_init is a reference only too.
  *   Standstill rule (T, MT): no new edge since the previous snapshot -> magnitude =
  *                    min(last magnitude, cpe / since), in the last direction: a slowly turning
  *                    shaft never reads 0 between edges, a stopped one decays like 1/t.
@@ -83,9 +89,11 @@ typedef struct {
     qei_vel_cfg_t  cfg;
     int            have_prev;
     qei_vel_snap_t prev;
-    int            mt_dir;
-    double         mt_mag;
-    int            t_dir;
+    int            mt_dir;   /* direction of motion for MT */
+    double         mt_mag;   /* magnitude of the last MT measurement, counts/s */
+    int            mt_ref;   /* the next new edge is a reference only */
+    int            t_dir;    /* direction of the last non-zero delta */
+    int            t_hold;   /* T reads 0: delta reversed, no new edge since */
 } qei_vel_t;
 
 /* Returns 0, or -1 when the configuration is out of range (the state is then unusable). */

@@ -140,7 +140,8 @@ def snap(count, time, edge_time, delta, edge_delta, **kw):
 def test_standstill_bound_never_zero_between_edges(c_estimator):
     """One count every 10 ms (any edge), read every 1 ms: between edges the M/T reading stays
     at the last measurement (100 counts/s) until the bound 1 / since falls below it, never 0;
-    M reads 0 nine times out of ten (that is the unit-time method)."""
+    M reads 0 nine times out of ten (that is the unit-time method). The first edge (10 ms) is a
+    reference only, the second (20 ms) gives the first measurement."""
     cfg = EstimatorConfig(tick_s=TICK, ts_w=32, counts_per_edge=1, stall_ticks=50_000)
     snaps, count, edge_t, prev_edge_count = [], 0, 0, 0
     for k in range(0, 60):
@@ -152,8 +153,9 @@ def test_standstill_bound_never_zero_between_edges(c_estimator):
         count, prev_edge_count = c, c
     r = both(c_estimator, cfg, snaps)
     mt = np.array([x[2] for x in r])
-    assert np.all(mt[12:] > 0), "M/T read 0 between edges at a constant slow speed"
-    assert np.allclose(mt[12:], 100.0), mt[12:]   # since <= 9.5 ms: bound 105 > 100
+    assert np.all(mt[:20] == 0), mt[:20]
+    assert np.all(mt[20:] > 0), "M/T read 0 between edges at a constant slow speed"
+    assert np.allclose(mt[20:], 100.0), mt[20:]   # since <= 9.5 ms: bound 105 > 100
     m = np.array([x[0] for x in r])
     assert np.sum(m[12:] == 0) >= 0.85 * len(m[12:])
 
@@ -163,19 +165,20 @@ def test_standstill_bound_decays_then_stall_reads_zero(c_estimator):
     min(1000, 1 / since) and are exactly 0 from since >= stall_ticks (30 ms) on; STATUS.STALLED
     also forces 0."""
     cfg = EstimatorConfig(tick_s=TICK, ts_w=32, counts_per_edge=1, stall_ticks=30_000)
-    snaps = [snap(9, 9_500, 9_000, 0, 0), snap(10, 10_500, 10_000, 1, 1)]
+    snaps = [snap(8, 8_500, 8_000, 0, 0), snap(9, 9_500, 9_000, 1, 1),
+             snap(10, 10_500, 10_000, 1, 1)]
     for k in range(11, 50):
         snaps.append(snap(10, 1000 * k + 500, 10_000, 0, 0))
     r = both(c_estimator, cfg, snaps)
     mt = [x[2] for x in r]
-    assert mt[1] == pytest.approx(1000.0)
-    for k, s in enumerate(snaps[2:], start=2):
+    assert mt[1] == 0.0                     # the first edge is a reference only
+    assert mt[2] == pytest.approx(1000.0)
+    for k, s in enumerate(snaps[3:], start=3):
         since = s.time - 10_000
         want = 0.0 if since >= 30_000 else min(1000.0, 1 / (since * TICK))
         assert mt[k] == pytest.approx(want), (k, since, mt[k], want)
     assert mt[-1] == 0.0 and mt[2] > 0
-    stalled = [snap(9, 9_500, 9_000, 0, 0), snap(10, 10_500, 10_000, 1, 1),
-               snap(10, 11_500, 10_000, 0, 0, stalled=1)]
+    stalled = snaps[:3] + [snap(10, 11_500, 10_000, 0, 0, stalled=1)]
     assert both(c_estimator, cfg, stalled)[-1][2] == 0.0
 
 
@@ -188,13 +191,38 @@ def test_one_edge_reversal_reads_zero(c_estimator):
              snap(0, 5_100, 3_500, 0, 0)]
     r = both(c_estimator, cfg, snaps)
     mt = [x[2] for x in r]
+    assert mt[1] == 0.0                     # first edge: reference
     assert mt[2] == pytest.approx(1000.0)
     assert mt[3] == 0.0, "a one-edge reversal must read 0"
     assert mt[4] == pytest.approx(-2000.0)
     assert mt[5] == pytest.approx(-1 / (1600 * TICK))   # standstill bound, backwards
     # there and back between two reads: a new edge with edge_delta 0 reads 0
-    snaps2 = [snap(0, 0, 0, 0, 0), snap(1, 1_100, 1_000, 1, 1), snap(1, 2_100, 1_900, 0, 0)]
+    snaps2 = snaps[:3] + [snap(2, 3_100, 2_900, 0, 0)]
     assert both(c_estimator, cfg, snaps2)[-1][2] == 0.0
+
+
+def test_reversal_seen_in_the_counts_before_an_a_rising_edge(c_estimator):
+    """A rising only (4 counts per edge): forward at 4000 counts/s, then the counts go back
+    (delta < 0) with no A-rising edge yet: the reading drops to 0 at once (not the old direction
+    under the standstill bound), the first backward A-rising edge is a reference only (its
+    edge_delta of +1 spans the reversal), the second reads the backward speed. T reads 0 from the
+    reversal until a new edge."""
+    cfg = EstimatorConfig(tick_s=TICK, ts_w=32, counts_per_edge=4)
+    snaps = [snap(0, 0, 0, 0, 0), snap(4, 1_100, 1_000, 4, 4, period=1000),
+             snap(8, 2_100, 2_000, 4, 4, period=1000),
+             snap(9, 3_100, 2_000, 1, 0, period=1000),        # forward, no edge
+             snap(7, 4_100, 2_000, -2, 0, period=1000),       # the counts reverse
+             snap(5, 5_100, 4_800, -2, 1, period=2800, period_dir_change=1),  # A rises backward
+             snap(1, 6_100, 5_800, -4, -4, period=1000),      # next one backward
+             ]
+    r = both(c_estimator, cfg, snaps)
+    mt, t = [x[2] for x in r], [x[1] for x in r]
+    assert mt[2] == pytest.approx(4000.0)
+    assert mt[3] == pytest.approx(4 / 1.1e-3)              # standstill bound 4 / 1.1 ms
+    assert mt[4] == 0.0 and t[4] == 0.0, "the counts reversed: must not read forward"
+    assert mt[5] == 0.0 and t[5] == 0.0
+    assert mt[6] == pytest.approx(-4000.0) and t[6] == pytest.approx(-4000.0)
+    assert all(x <= 0 for x in mt[4:]) and all(x <= 0 for x in t[4:])
 
 
 def test_timebase_wrap(c_estimator):

@@ -27,12 +27,16 @@ edges with x4 counting), ``since`` = time - edge_time (ticks since the last sele
   reads 0 at low speed. (``delta_from_count``: use the wrapped count difference instead of
   SNAP_DELTA, hostmot2 style; wraps at COUNT_W bits.)
 - **T (period)**: ``period_n * cpe / period`` in the direction of the last non-zero ``delta``.
-  0 when there is no measurement yet (``period == 0``), on period overflow, or when the
-  measurement spans a direction change (``period_dir_change``).
+  0 when there is no measurement yet (``period == 0``), on period overflow, when the
+  measurement spans a direction change (``period_dir_change``), and from a snapshot whose
+  ``delta`` reverses the direction until the next new edge in a later snapshot.
 - **M/T (timestamp, hostmot2)**: on a new edge, ``edge_delta / (edge_time - prev.edge_time)``.
-  **Reversal rule**: when the sign of ``edge_delta`` differs from the last non-zero one, the
-  reading is 0 (hostmot2's one-edge-reversal rule; the next reading is measured normally). A new
-  edge with ``edge_delta == 0`` (there and back) reads 0.
+  **Reversal rule**: a new edge whose ``edge_delta`` has the sign opposite to the last one reads
+  0 and becomes the new reference (hostmot2's one-edge-reversal rule); so does a new edge with
+  ``edge_delta == 0`` (there and back). When ``delta`` goes against the last direction before a
+  selected edge confirms it (A rising at low speed), the reading is 0 at once, the direction
+  follows the counts, and the next new edge is a reference only (its interval spans the
+  reversal). The first new edge after initialisation is a reference only too.
 
 **Standstill rule** (T and M/T): with no new edge since the previous snapshot, the magnitude is
 ``min(last magnitude, cpe / since)`` -- at most one selected edge's worth of counts over the time
@@ -128,9 +132,11 @@ class VelocityEstimator:
     def __init__(self, cfg: EstimatorConfig):
         self.cfg = cfg
         self.prev: Snapshot | None = None
-        self.mt_dir = 0       # direction of the last non-zero edge_delta
+        self.mt_dir = 0       # direction of motion for M/T (edge_delta, or delta on a reversal)
         self.mt_mag = 0.0     # magnitude of the last M/T measurement (counts/s)
+        self.mt_ref = True    # the next new edge is a reference only (start, after a reversal)
         self.t_dir = 0        # direction of the last non-zero delta
+        self.t_hold = False   # T reads 0: delta reversed, no new edge since
 
     def _dt(self, a, b):
         """a - b in ticks, modulo 2^TS_W."""
@@ -165,23 +171,35 @@ class VelocityEstimator:
         since = self._dt(s.time, s.edge_time)
         stalled = bool(s.stalled) or (cfg.stall_ticks > 0 and since >= cfg.stall_ticks)
         new_edge = s.edge_delta != 0 or s.edge_time != p.edge_time
+        cdir = _sign(delta)
         # M/T: timestamp
+        if cdir != 0 and self.mt_dir != 0 and cdir != self.mt_dir:
+            self.mt_dir = cdir                    # the counts reversed: 0 until re-referenced
+            self.mt_mag = 0.0
+            self.mt_ref = True
         if new_edge:
             d = _sign(s.edge_delta)
-            if d == 0:
+            if self.mt_ref or d == 0 or (self.mt_dir != 0 and d != self.mt_dir):
+                if d != 0 and not self.mt_ref:
+                    self.mt_dir = d               # reversal rule: reads 0, new reference
+                elif self.mt_dir == 0:
+                    self.mt_dir = d
                 self.mt_mag = 0.0
+                self.mt_ref = False
             else:
                 dte = self._dt(s.edge_time, p.edge_time)
-                if self.mt_dir != 0 and d != self.mt_dir:
-                    self.mt_mag = 0.0             # reversal rule
-                elif dte > 0:
+                if dte > 0:
                     self.mt_mag = abs(s.edge_delta) / (dte * tick)
                 self.mt_dir = d
         mt = self.mt_dir * self._bounded(self.mt_mag, new_edge, since, stalled)
         # T: period
-        if delta != 0:
-            self.t_dir = _sign(delta)
-        if s.period == 0 or s.period_ovf or s.period_dir_change:
+        if cdir != 0 and self.t_dir != 0 and cdir != self.t_dir:
+            self.t_hold = True
+        elif new_edge:
+            self.t_hold = False
+        if cdir != 0:
+            self.t_dir = cdir
+        if self.t_hold or s.period == 0 or s.period_ovf or s.period_dir_change:
             t_mag = 0.0
         else:
             t_mag = max(s.period_n, 1) * cfg.counts_per_edge / (s.period * tick)
@@ -267,14 +285,38 @@ def edge_table(wf) -> EdgeTable:
                      np.array(arise, bool), 0)
 
 
+@dataclass
+class SnapTrace:
+    """Snapshots plus what they refer to in the model: per read, the read time ``t_read_s``, the
+    time of the clock that latched it ``t_latch_s``, the edge-table index of the last selected
+    edge seen (``last_edge``, -1: none yet) and of the edges bounding the measurement in PERIOD
+    (``period_from``, ``period_to``, -1: none)."""
+
+    snaps: list
+    t_read_s: np.ndarray
+    t_latch_s: np.ndarray
+    last_edge: np.ndarray
+    period_from: np.ndarray
+    period_to: np.ndarray
+
+
 def ideal_snapshots(wf_or_table, read_hz: float = 1000.0, edge: str = "any", period_n: int = 1,
                     timebase: Timebase | None = None, t0_s: float = 0.0,
                     t_end_s: float | None = None, count_w: int = 32):
     """Snapshots an ideal enc_qei would latch when read at ``read_hz`` from ``t0_s``.
 
-    Returns ``(snaps, t_read_s)``: the :class:`Snapshot` list and the read times. With
-    ``timebase=None`` times are exact, in ns, and never wrap (``EstimatorConfig(tick_s=1e-9,
-    ts_w=None)``); with a :class:`Timebase` they are its ticks, wrapped at TS_W bits."""
+    Returns ``(snaps, t_read_s)``: the :class:`Snapshot` list and the read times (for the edge
+    bookkeeping as well, use :func:`snapshot_trace`). With ``timebase=None`` times are exact, in
+    ns, and never wrap (``EstimatorConfig(tick_s=1e-9, ts_w=None)``); with a :class:`Timebase`
+    they are its ticks, wrapped at TS_W bits."""
+    tr = snapshot_trace(wf_or_table, read_hz, edge, period_n, timebase, t0_s, t_end_s, count_w)
+    return tr.snaps, tr.t_read_s
+
+
+def snapshot_trace(wf_or_table, read_hz: float = 1000.0, edge: str = "any", period_n: int = 1,
+                   timebase: Timebase | None = None, t0_s: float = 0.0,
+                   t_end_s: float | None = None, count_w: int = 32) -> SnapTrace:
+    """:func:`ideal_snapshots` with the edge bookkeeping (a :class:`SnapTrace`)."""
     if edge not in EDGE_TYPES:
         raise ValueError(f"edge type must be one of {EDGE_TYPES}, not {edge!r}")
     if read_hz <= 0:
@@ -284,18 +326,20 @@ def ideal_snapshots(wf_or_table, read_hz: float = 1000.0, edge: str = "any", per
     et = wf_or_table if isinstance(wf_or_table, EdgeTable) else edge_table(wf_or_table)
     if t_end_s is None:
         t_end_s = (et.t_s[-1] if et.t_s.size else 0.0) + 1.0 / read_hz
-    n_reads = int(math.floor((t_end_s - t0_s) * read_hz)) + 1
-    t_read = t0_s + np.arange(max(n_reads, 0)) / read_hz
+    n_reads = max(int(math.floor((t_end_s - t0_s) * read_hz + 1e-9)) + 1, 0)
+    t_read = t0_s + np.arange(n_reads) / read_hz
     # when the peripheral sees the steps and the reads, and what its timebase says then
     if timebase is None:
         seen_e, seen_r = et.t_s, t_read
         tstamp_e, tstamp_r = et.t_s * 1e9, t_read * 1e9
+        t_latch = t_read
         mask = None
     else:
         ck_e = timebase.clock_of(et.t_s) + timebase.latency_clocks
         ck_r = timebase.clock_of(t_read)
         seen_e, seen_r = ck_e, ck_r
         tstamp_e, tstamp_r = timebase.ticks(ck_e), timebase.ticks(ck_r)
+        t_latch = (ck_r + timebase.phase) / timebase.clk_hz
         mask = (1 << timebase.ts_w) - 1
     sel = np.flatnonzero(et.a_rise) if edge == "a_rising" else np.arange(et.step.size)
     # steps seen at or before each read ("this clock's edge included")
@@ -303,41 +347,68 @@ def ideal_snapshots(wf_or_table, read_hz: float = 1000.0, edge: str = "any", per
     n_sel = np.searchsorted(seen_e[sel], seen_r, side="right")   # selected edges seen
     pos_ext = np.concatenate([[et.pos0], et.pos])
     count = pos_ext[n_steps]
-    # count after the last selected edge seen (0 before the first)
     pos_sel = np.concatenate([[et.pos0], et.pos[sel]])
-    edge_count = pos_sel[n_sel]
-    t_sel = np.concatenate([[tstamp_r[0] * 0], tstamp_e[sel]]) if sel.size else np.zeros(1)
-    edge_time = t_sel[n_sel] if sel.size else np.zeros(n_reads)
+    edge_count = pos_sel[n_sel]          # count after the last selected edge (pos0 before one)
+    sel_ext = np.concatenate([[-1], sel])
+    last_edge = sel_ext[n_sel]
     # period: blocks of period_n selected edges from the first one
     dirchg = np.zeros(et.step.size, np.int64)
     if et.step.size > 1:
         d = np.sign(et.step)
         dirchg[1:] = (d[1:] != d[:-1]).astype(np.int64)
     cum_chg = np.cumsum(dirchg)
-    blocks = (n_sel - 1) // period_n               # completed blocks = index of last end edge
+    blocks = np.where(n_sel >= 1, (n_sel - 1) // period_n, -1)
+    p_from = np.full(n_reads, -1, np.int64)
+    p_to = np.full(n_reads, -1, np.int64)
+    ok = blocks >= 1
+    p_to[ok] = sel[blocks[ok] * period_n]
+    p_from[ok] = sel[(blocks[ok] - 1) * period_n]
     snaps = []
     cw = (1 << count_w) - 1
     prev_count, prev_edge_count = et.pos0, et.pos0
     for i in range(n_reads):
-        j = blocks[i] if n_sel[i] >= 1 else -1
         period, ovf, dchg = 0, 0, 0
-        if j >= 1:
-            e1, e0 = sel[j * period_n], sel[(j - 1) * period_n]
+        if p_to[i] >= 0:
+            e1, e0 = p_to[i], p_from[i]
             period = tstamp_e[e1] - tstamp_e[e0]
             dchg = int(cum_chg[e1] - cum_chg[e0] > 0)
             if mask is not None:
                 if period > mask:
                     period, ovf = mask, 1
                 period = int(period)
-        tr, te = tstamp_r[i], edge_time[i]
+        tr = tstamp_r[i]
+        te = tstamp_e[last_edge[i]] if last_edge[i] >= 0 else tr * 0
         if mask is not None:
             tr, te = int(tr) & mask, int(te) & mask
+        else:
+            tr, te = float(tr), float(te)
         snaps.append(Snapshot(
             count=int(count[i]) & cw, time=tr, edge_time=te,
             delta=int(count[i] - prev_count), edge_delta=int(edge_count[i] - prev_edge_count),
-            period=period, period_n=period_n, period_ovf=ovf, period_dir_change=dchg))
+            period=period if mask is not None else float(period), period_n=period_n,
+            period_ovf=ovf, period_dir_change=dchg))
         prev_count, prev_edge_count = count[i], edge_count[i]
-    return snaps, t_read
+    return SnapTrace(snaps, t_read, np.asarray(t_latch, float), last_edge, p_from, p_to)
+
+
+def exact_twin(trace: SnapTrace, et: EdgeTable, latency_s: float = 0.0) -> list:
+    """The snapshots of ``trace`` with every time replaced by the exact one (ns, float, no wrap):
+    SNAP_TIME by the latching clock's time, SNAP_EDGE_TIME by the pin time of the same edge plus
+    ``latency_s``, PERIOD by the exact time between its two edges. Counts stay as latched. Run
+    with ``EstimatorConfig(tick_s=1e-9, ts_w=None)``: the same estimator on the encoder's exact
+    edge times, so the difference to the latched readings is what the timebase adds."""
+    out = []
+    for i, s in enumerate(trace.snaps):
+        le = trace.last_edge[i]
+        te = (et.t_s[le] + latency_s) * 1e9 if le >= 0 else 0.0
+        period = 0.0
+        if trace.period_to[i] >= 0 and not s.period_ovf:
+            period = (et.t_s[trace.period_to[i]] - et.t_s[trace.period_from[i]]) * 1e9
+        out.append(Snapshot(count=s.count, time=float(trace.t_latch_s[i] * 1e9), edge_time=te,
+                            delta=s.delta, edge_delta=s.edge_delta, period=period,
+                            period_n=s.period_n, period_ovf=s.period_ovf,
+                            period_dir_change=s.period_dir_change, stalled=s.stalled))
+    return out
 
 
 def true_rpm(profile, t_s) -> np.ndarray:

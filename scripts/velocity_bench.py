@@ -1,0 +1,745 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Velocity-method accuracy on modelled HEDS-5000 units (`make velocity`).
+
+Which velocity method to use at which speed, and how accurate each really is on this encoder:
+the unit-time (M), period (T) and timestamp (M/T, hostmot2) estimators of
+``hedsmodel.velocity`` (the same as ``sw/enc_qei_velocity.c``), each with edges of any type or A
+rising only, read at 1 kHz, on an ideal unit and on units drawn from the application note's
+tables, at constant speeds from 1 to 12,000 rpm (log-spaced), a ramp, a reversal and a stop.
+
+Two layers:
+
+(a) **model** (always): the snapshots an ideal enc_qei latches (``hedsmodel.velocity.
+    snapshot_trace``: edges seen at the first clock after the pins plus the pipeline latency,
+    timestamps in timebase ticks of a ``--clk-mhz`` clock with ``--prescale``, TS_W = 32). For
+    every reading, the *floor* is the same estimator on the model's exact edge times for the same
+    edges and counts (``exact_twin``): the encoder's own error. *Added* = |latched - floor| /
+    true speed: what the timebase quantisation adds. A prescaler table shows the trade-off.
+(b) **sim** (``--sim icarus|verilator``, default: whichever is there): the same for a short
+    window per speed (``--sim-reads`` reads at 1 kHz) read through enc_qei_wb over Wishbone
+    (cocotb: ``scripts/benches/velocity_bench_sim.py``): the host writes SNAP_CTRL.CMD and reads
+    the snapshot registers; the readings are compared with the floor on the same edges (each
+    SNAP_EDGE_TIME is matched to its model edge) and SNAP_EDGE_DELTA with the model's count.
+    Skipped, and said so, when the RTL lacks the timing registers.
+
+Writes doc/results/velocity_methods.md and sim/figures/velocity_methods.png; one progress line
+per speed. Usage:
+  scripts/velocity_bench.py [--rpm-min R] [--rpm-max R] [--points N] [--units N] [--seed N]
+                            [--quick] [--jobs N] [--sim auto|none|icarus|verilator]
+                            [--sim-reads N] [--prescale P] [--clk-mhz F] [--stall-ms T]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+TOP = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(TOP / "tb" / "common"))   # the cocotb harness (sim layer)
+TABLE = TOP / "doc" / "results" / "velocity_methods.md"
+FIGURE = TOP / "sim" / "figures" / "velocity_methods.png"
+RAW = TOP / "sim" / "build" / "velocity_raw.json"   # every number, not committed
+
+READ_HZ = 1000.0
+FILTER_LEN = 3                     # enc_qei's reset value; edges seen FILTER_LEN + 3 clocks late
+VARIANTS = (("M", "any"), ("T", "any"), ("T", "a_rising"), ("MT", "any"), ("MT", "a_rising"))
+LABEL = {("M", "any"): "M", ("T", "any"): "T any edge", ("T", "a_rising"): "T A↑",
+         ("MT", "any"): "M/T any edge", ("MT", "a_rising"): "M/T A↑"}
+GOAL_ADDED_TYP = 1e-3              # hardware adds <= 0.1 % of the reading (30 .. 12,000 rpm)
+GOAL_ADDED_IDEAL = 2e-4            # <= 0.02 % on the ideal unit
+GOAL_NONZERO_RPM = 6.0
+GOAL_BAND = (30.0, 12000.0)
+# Shaft speeds are detuned by this factor: a round speed makes every edge interval a whole number
+# of clocks (12,000 rpm = 1,000 clocks per cycle at 100 MHz), which hides the timebase's
+# quantisation; detuned, the edges meet every clock phase, as a real shaft's do.
+DETUNE = 1.000137
+
+
+# ----------------------------------------------------------------------------- arguments
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):   # one line, no usage dump
+        self.exit(2, f"velocity_bench: {message}\n")
+
+
+def _num(kind, lo=None, hi=None, lo_open=False):
+    def conv(text):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {'an integer' if kind is int else 'a number'}")
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{text!r} is not finite")
+        if lo is not None and (v <= lo if lo_open else v < lo):
+            raise argparse.ArgumentTypeError(f"{text} must be {'>' if lo_open else '>='} {lo}")
+        if hi is not None and v > hi:
+            raise argparse.ArgumentTypeError(f"{text} must be <= {hi}")
+        return v
+    return conv
+
+
+def parse_args(argv=None):
+    p = Parser(description="Velocity-method accuracy on modelled HEDS-5000 units (make velocity).")
+    p.add_argument("--rpm-min", type=_num(float, 0, 60000, lo_open=True), default=1.0,
+                   help="lowest constant speed, rpm (default 1)")
+    p.add_argument("--rpm-max", type=_num(float, 0, 60000, lo_open=True), default=12000.0,
+                   help="highest constant speed, rpm (default 12000)")
+    p.add_argument("--points", type=_num(int, 2, 60), default=12,
+                   help="log-spaced speeds (6 and 30 rpm are added when in range; default 12)")
+    p.add_argument("--units", type=_num(int, 0, 12), default=4,
+                   help="non-ideal units: half typical (table means), half drawn (default 4)")
+    p.add_argument("--seed", type=_num(int, 0, 2**63 - 1), default=2026,
+                   help="seed for the units and read phases (default 2026)")
+    p.add_argument("--quick", action="store_true", help="short runs (about a minute)")
+    p.add_argument("--jobs", type=_num(int, 1, 64), default=2, help="worker processes")
+    p.add_argument("--sim", choices=("auto", "none", "icarus", "verilator"), default="auto",
+                   help="simulated layer through enc_qei (auto: Verilator if present, else Icarus)")
+    p.add_argument("--sim-reads", type=_num(int, 3, 200), default=6,
+                   help="1 kHz reads per speed in the simulated layer (default 6)")
+    p.add_argument("--prescale", type=_num(int, 0, 65535), default=0,
+                   help="TB_PRESCALE.PRESCALE: timebase tick = (P+1) clocks (default 0)")
+    p.add_argument("--clk-mhz", type=_num(float, 1, 1000), default=100.0,
+                   help="peripheral clock, MHz (default 100)")
+    p.add_argument("--stall-ms", type=_num(float, 0, 10000, lo_open=True), default=200.0,
+                   help="stall timeout of the estimators, ms (default 200)")
+    a = p.parse_args(argv)
+    if a.rpm_min >= a.rpm_max:
+        p.error(f"--rpm-min ({a.rpm_min:g}) must be below --rpm-max ({a.rpm_max:g})")
+    tick = (a.prescale + 1) / (a.clk_mhz * 1e6)
+    if a.stall_ms * 1e-3 >= 2**32 * tick:
+        p.error(f"--stall-ms {a.stall_ms:g} exceeds the 32-bit timebase's wrap "
+                f"({2**32 * tick:.3g} s at this clock and prescaler)")
+    if tick > 1e-4:
+        p.error(f"timebase tick {tick * 1e6:g} us is too coarse for 1 kHz reads "
+                "(lower --prescale or raise --clk-mhz)")
+    return a
+
+
+# ----------------------------------------------------------------------------- model layer
+
+def speeds(args) -> list[float]:
+    import numpy as np
+
+    grid = np.exp(np.linspace(math.log(args.rpm_min), math.log(args.rpm_max), args.points))
+    forced = {v for v in (GOAL_NONZERO_RPM, GOAL_BAND[0]) if args.rpm_min <= v <= args.rpm_max}
+    forced |= {args.rpm_min, args.rpm_max}
+    out = {float(f"{v:.3g}") for v in grid if all(abs(v / f - 1) > 0.1 for f in forced)}
+    return sorted(out | forced)
+
+
+def make_units(args):
+    """[(name, EncoderUnit)]: the ideal unit, then typical and drawn ones."""
+    import numpy as np
+
+    from hedsmodel import EncoderUnit
+
+    rng = np.random.default_rng(args.seed)
+    units = [("ideal", EncoderUnit())]
+    for i in range(args.units):
+        if i % 2 == 0:
+            units.append((f"typical {i // 2 + 1}", EncoderUnit.typical(rng)))
+        else:
+            units.append((f"drawn {i // 2 + 1}", EncoderUnit.draw(rng)))
+    return units
+
+
+def unit_summary(unit) -> dict:
+    from hedsmodel import Profile, measure
+
+    wf = unit.waveform(Profile().constant(600, 0.1))   # one revolution
+    m = measure(wf)
+    return {"state_error_deg": m.state_error_deg, "phase_error_deg": m.phase_error_deg,
+            "pulse_error_deg": m.pulse_error_deg, "cycle_error_deg": m.cycle_error_deg,
+            "ecc_mm": unit.eccentricity_mm}
+
+
+def timebase(args, prescale=None):
+    from hedsmodel.velocity import Timebase
+
+    return Timebase(clk_hz=args.clk_mhz * 1e6,
+                    prescale=args.prescale if prescale is None else prescale, ts_w=32,
+                    latency_clocks=FILTER_LEN + 3)
+
+
+def build_profile(spec):
+    from hedsmodel import Profile
+
+    p = Profile()
+    for seg in spec:
+        getattr(p, seg[0])(*seg[1:])
+    return p
+
+
+def read_model(job) -> dict:
+    """One unit on one profile: readings of every variant, latched and floor, and the truth."""
+    import numpy as np
+
+    from hedsmodel.velocity import (EstimatorConfig, counts_per_edge, edge_table, estimate,
+                                    exact_twin, snapshot_trace, true_rpm)
+
+    t_start = time.perf_counter()
+    unit, prof, tb, stall_s = job["unit"], build_profile(job["profile"]), job["tb"], job["stall_s"]
+    et = edge_table(unit.waveform(prof))
+    lat = tb.latency_clocks / tb.clk_hz
+    out = {"t": None, "true": None, "readings": {}}
+    for edge in ("any", "a_rising"):
+        tr = snapshot_trace(et, READ_HZ, edge, 1, tb, job["t0"], job["t_end"])
+        cpe = counts_per_edge(edge)
+        cfg_q = EstimatorConfig(tick_s=tb.tick_s, ts_w=tb.ts_w, counts_per_edge=cpe,
+                                stall_ticks=int(round(stall_s / tb.tick_s)))
+        cfg_x = EstimatorConfig(tick_s=1e-9, ts_w=None, counts_per_edge=cpe,
+                                stall_ticks=stall_s * 1e9)
+        hw = estimate(tr.snaps, cfg_q)
+        ex = estimate(exact_twin(tr, et, lat), cfg_x)
+        for meth in ("M", "T", "MT"):
+            if (meth, edge) in VARIANTS:
+                out["readings"][f"{meth}/{edge}"] = {"hw": hw[meth], "floor": ex[meth]}
+        if out["t"] is None:
+            out["t"] = tr.t_latch_s
+            out["true"] = true_rpm(prof, tr.t_latch_s - lat)
+    # scoring starts one read after the third A-rising edge and from the third read on (every
+    # estimator is warm then: the first read initialises, the first new edge is a reference)
+    rises = et.t_s[et.a_rise]
+    warm = (rises[2] if rises.size > 2 else math.inf) + 1.0 / READ_HZ
+    out["score"] = (out["t"] >= warm + lat) & (np.arange(out["t"].size) >= 2)
+    out["wall_s"] = time.perf_counter() - t_start
+    out["edges"] = int(et.step.size)
+    out["last_edge_s"] = float(et.t_s[-1]) if et.t_s.size else 0.0
+    out["motion_end_s"] = max((pc.tb for pc in prof.pieces()), default=0.0)
+    return out
+
+
+def score(res, band=None) -> dict:
+    """Per variant: relative errors (latched and floor), added by the hardware, zero readings."""
+    import numpy as np
+
+    true = res["true"]
+    sel = res["score"] & (np.abs(true) > 0)
+    if band is not None:
+        sel &= (np.abs(true) >= band[0]) & (np.abs(true) <= band[1])
+    out = {}
+    for key, r in res["readings"].items():
+        hw, fl = r["hw"][sel], r["floor"][sel]
+        u = np.abs(true[sel])
+        if u.size == 0:
+            continue
+        e_hw, e_fl = np.abs(hw - true[sel]) / u, np.abs(fl - true[sel]) / u
+        add = np.abs(hw - fl) / u
+        out[key] = {"n": int(u.size), "rms": float(np.sqrt(np.mean(e_hw ** 2))),
+                    "max": float(e_hw.max()), "floor_rms": float(np.sqrt(np.mean(e_fl ** 2))),
+                    "floor_max": float(e_fl.max()), "added_max": float(add.max()),
+                    "added_rms": float(np.sqrt(np.mean(add ** 2))),
+                    "zeros": int(np.sum(hw == 0))}
+    return out
+
+
+def random_phase(tb, rng):
+    """The timebase with a random clock phase and prescaler count (edges meet every phase)."""
+    import dataclasses
+
+    return dataclasses.replace(tb, phase=float(rng.uniform(0, 1)),
+                               tb_offset=int(rng.integers(tb.prescale + 1)))
+
+
+def constant_jobs(args, units, rpms, rng):
+    dur_min, dur_max = (0.05, 2.0) if args.quick else (0.25, 30.0)
+    jobs = []
+    for rpm in rpms:
+        dur = min(max(60.0 / rpm, dur_min), dur_max)    # one revolution when affordable
+        for name, unit in units:
+            jobs.append({"kind": "constant", "rpm": rpm, "unit_name": name, "unit": unit,
+                         "profile": [("constant", rpm * DETUNE, dur)],
+                         "tb": random_phase(timebase(args), rng),
+                         "t0": float(rng.uniform(0, 1 / READ_HZ)), "t_end": dur,
+                         "stall_s": args.stall_ms * 1e-3})
+    return jobs
+
+
+SCENARIOS = {
+    # name: (profile, description)
+    "ramp": ([("ramp", 30.0, 3000.0, 0.5)], "ramp 30 → 3000 rpm in 0.5 s (5,940 rpm/s)"),
+    "reversal": ([("ramp", 300.0, -300.0, 0.4)], "ramp 300 → −300 rpm in 0.4 s (reverses at 0.2 s)"),
+    "stop": ([("constant", 60.0, 0.3), ("stop", 0.6)], "60 rpm for 0.3 s, then stop for 0.6 s"),
+    "stop6": ([("constant", 6.0, 0.5), ("stop", 0.6)], "6 rpm for 0.5 s, then stop for 0.6 s"),
+}
+
+
+def scenario_jobs(args, units, rng):
+    tb = timebase(args)
+    jobs = []
+    for sname, (spec, _) in SCENARIOS.items():
+        dur = build_profile(spec).duration_s
+        for name, unit in units:
+            jobs.append({"kind": sname, "unit_name": name, "unit": unit, "profile": spec,
+                         "tb": random_phase(tb, rng), "t0": float(rng.uniform(0, 1 / READ_HZ)), "t_end": dur,
+                         "stall_s": args.stall_ms * 1e-3})
+    return jobs
+
+
+PRESCALES = (0, 4, 9, 49, 99)
+PRESCALE_RPMS = (30.0, 300.0, 3000.0, 12000.0)
+
+
+def prescale_jobs(args, units, rng):
+    jobs = []
+    for p in PRESCALES:
+        tb = timebase(args, prescale=p)
+        for rpm in PRESCALE_RPMS:
+            dur = 0.3 if args.quick else max(60.0 / rpm, 0.5)
+            for name, unit in units[:2]:
+                jobs.append({"kind": "prescale", "prescale": p, "rpm": rpm, "unit_name": name,
+                             "unit": unit, "profile": [("constant", rpm * DETUNE, dur)],
+                             "tb": random_phase(tb, rng),
+                             "t0": float(rng.uniform(0, 1 / READ_HZ)), "t_end": dur,
+                             "stall_s": args.stall_ms * 1e-3})
+    return jobs
+
+
+def scenario_metrics(kind, res, stall_s) -> dict:
+    """Ramp: errors where |true| >= 30 rpm. Reversal: wrong-sign readings where |true| >= 6 rpm,
+    zero readings, errors at >= 30 rpm. Stop: time from the stop to the first 0 of each variant
+    that stays 0."""
+    import numpy as np
+
+    out = {}
+    t, true = res["t"], res["true"]
+    if kind in ("ramp", "reversal"):
+        sc = score(res, band=(30.0, 1e9))
+        for key, r in res["readings"].items():
+            hw = r["hw"]
+            big = res["score"] & (np.abs(true) >= GOAL_NONZERO_RPM)
+            wrong = int(np.sum(big & (np.sign(hw) != np.sign(true)) & (hw != 0)))
+            zeros = int(np.sum(big & (hw == 0)))
+            out[key] = {**sc.get(key, {}), "wrong_sign": wrong, "zeros_moving": zeros,
+                        "n_moving": int(np.sum(big))}
+    else:
+        moving = np.abs(true) > 0
+        t_stop = res["motion_end_s"]
+        for key, r in res["readings"].items():
+            hw = r["hw"]
+            after = t > t_stop
+            nz = np.flatnonzero(after & (hw != 0))
+            t_zero = float(t[nz[-1] + 1]) if nz.size and nz[-1] + 1 < t.size else (
+                float(t[after][0]) if not nz.size and after.any() else math.nan)
+            run = res["score"] & moving
+            out[key] = {"t_to_zero_s": t_zero - t_stop, "since_last_edge_s":
+                        t_zero - res["last_edge_s"], "zeros_moving": int(np.sum(run & (hw == 0))),
+                        "n_moving": int(np.sum(run))}
+    return out
+
+
+def run_model(args, units):
+    import numpy as np
+
+    rng = np.random.default_rng([args.seed, 1])
+    rpms = speeds(args)
+    const = constant_jobs(args, units, rpms, rng)
+    scen = scenario_jobs(args, units, rng)
+    pres = prescale_jobs(args, units, rng)
+    results = {"constant": {}, "scenario": {}, "prescale": {}}
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=args.jobs) as ex:
+        futs = [(j, ex.submit(read_model, j)) for j in const + scen + pres]
+        by_rpm: dict = {}
+        done_rpm = set()
+        for j, f in futs:
+            res = f.result()
+            if j["kind"] == "constant":
+                by_rpm.setdefault(j["rpm"], {})[j["unit_name"]] = (score(res), res["wall_s"])
+                if len(by_rpm[j["rpm"]]) == len(units) and j["rpm"] not in done_rpm:
+                    done_rpm.add(j["rpm"])
+                    rows = by_rpm[j["rpm"]]
+                    results["constant"][j["rpm"]] = {u: s for u, (s, _) in rows.items()}
+                    worst = max((s.get("MT/a_rising", {}).get("rms", math.nan)
+                                 for u, (s, _) in rows.items() if u != "ideal"), default=math.nan)
+                    added = max(s.get("MT/a_rising", {}).get("added_max", 0.0)
+                                for s, _ in rows.values())
+                    zeros = sum(s.get("MT/a_rising", {}).get("zeros", 0) for s, _ in rows.values())
+                    print(f"model {len(done_rpm):2d}/{len(rpms)} {j['rpm']:>8g} rpm: "
+                          f"M/T A↑ worst rms {100 * worst:.3f} %, hardware adds <= "
+                          f"{100 * added:.4f} %, zero readings {zeros} "
+                          f"({sum(w for _, w in rows.values()):.1f} s cpu)", flush=True)
+            elif j["kind"] == "prescale":
+                results["prescale"].setdefault(j["prescale"], {}).setdefault(
+                    j["rpm"], {})[j["unit_name"]] = score(res)
+            else:
+                results["scenario"].setdefault(j["kind"], {})[j["unit_name"]] = \
+                    scenario_metrics(j["kind"], res, args.stall_ms * 1e-3)
+                if j["unit_name"] == units[-1][0]:
+                    print(f"model scenario {j['kind']}: done", flush=True)
+    results["wall_s"] = time.perf_counter() - t0
+    results["rpms"] = rpms
+    return results
+
+
+# ----------------------------------------------------------------------------- sim layer
+
+def rtl_has_timing() -> tuple[bool, str]:
+    """Whether enc_qei's RTL implements the snapshot registers (decoded in rtl/enc_qei_regs.v)."""
+    regs = TOP / "rtl" / "enc_qei_regs.v"
+    top = TOP / "rtl" / "enc_qei_wb.v"
+    if not top.exists() or not regs.exists():
+        return False, "rtl/enc_qei_wb.v or rtl/enc_qei_regs.v is missing"
+    text = "".join(p.read_text(errors="replace") for p in sorted((TOP / "rtl").glob("enc_qei*.v")))
+    missing = [n for n in ("SNAP_EDGE_TIME", "SNAP_EDGE_DELTA", "SNAP_DELTA", "PERIOD")
+               if n.lower() not in text.lower()]
+    if missing:
+        return False, "the RTL does not mention " + ", ".join(missing)
+    return True, ""
+
+
+def default_sim() -> str:
+    venv_verilator = list((TOP / ".venv" / "lib").glob("python3*/site-packages/verilator/bin/verilator"))
+    return "verilator" if venv_verilator or shutil.which("verilator") else "icarus"
+
+
+def run_sim(args, units, rpms) -> dict:
+    return {"skipped": "the simulated layer is not written yet"}
+
+
+# ----------------------------------------------------------------------------- outputs
+
+def fmt_pct(x, digits=3) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "—"
+    v = 100 * x
+    if v < 1e-7:
+        return "0"
+    if v >= 100:
+        return f"{v:,.0f}"
+    if v >= 10:
+        return f"{v:.1f}"
+    return f"{v:.{digits}f}" if v >= 0.001 or v == 0 else f"{v:.1e}"
+
+
+def worst(rows: dict, key: str, metric: str, units=None) -> float:
+    vals = [r[key][metric] for u, r in rows.items() if key in r and (units is None or u in units)]
+    return max(vals) if vals else math.nan
+
+
+def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> list[str]:
+    """The Markdown report; returns the list of goal verdict lines."""
+    import numpy as np
+
+    tb = timebase(args)
+    typ = [n for n, _ in units if n != "ideal"]
+    rpms = model["rpms"]
+    C = model["constant"]
+    L = []
+    L += ["<!-- written by scripts/velocity_bench.py (make velocity); do not edit by hand -->", "",
+          "# Velocity methods on a HEDS-5000: what each reads, and what enc_qei adds", "",
+          f"Modelled HEDS-5000 units (hedsmodel; 500 cycles/rev, x4 = 2,000 counts/rev) read at "
+          f"1 kHz by the estimators of `hedsmodel.velocity` / `sw/enc_qei_velocity.c`. Timebase "
+          f"{args.clk_mhz:g} MHz / (PRESCALE {args.prescale} + 1) = {tb.tick_s * 1e9:g} ns tick, "
+          f"TS_W 32; edges seen {FILTER_LEN + 3} clocks after the pins (FILTER_LEN {FILTER_LEN}); "
+          f"estimator stall timeout {args.stall_ms:g} ms. Seed {args.seed}"
+          f"{', --quick' if args.quick else ''}; {wall_s / 60:.1f} min on {args.jobs} "
+          f"job(s). Relative errors in % of the true shaft speed: *rms* and *max* over the "
+          f"readings of a run (one revolution per speed, at most "
+          f"{2 if args.quick else 30} s, from the third read and one read after the third A-rising edge); "
+          "*floor* = the same estimator on the model's exact edge times (the encoder's own "
+          "error); *added* = max |latched − floor| / true speed (what the timebase adds); "
+          "*zeros* = readings of exactly 0 while turning.", ""]
+    L += ["Methods: **M** = SNAP_DELTA / Δ SNAP_TIME (unit time); **T** = edges / PERIOD "
+          "(N = 1, period of one selected edge); **M/T** = SNAP_EDGE_DELTA / Δ SNAP_EDGE_TIME "
+          "(timestamp, hostmot2). *any edge* = every x4 transition (A and B, rising and falling); "
+          "*A↑* = A rising only (one per cycle). T and M/T carry the standstill rule (no new edge: "
+          "at most one edge's counts over the time since the last edge) and the stall timeout; "
+          "M has neither.", ""]
+    # units
+    L += ["## Units", "", "| unit | state-width error ΔS (e°) | phase error (e°) | pulse-width error (e°) "
+          "| cycle error (e°) | eccentricity TIR (mm) |", "|---|---:|---:|---:|---:|---:|"]
+    for n, _ in units:
+        s = usum[n]
+        L.append(f"| {n} | {s['state_error_deg']:.1f} | {s['phase_error_deg']:.1f} | "
+                 f"{s['pulse_error_deg']:.1f} | {s['cycle_error_deg']:.2f} | {s['ecc_mm']:.4f} |")
+    L.append("")
+    # which method at which speed
+    L += ["## Which method at which speed", "",
+          "rms error (%) of each method, latched by the modelled peripheral, worst of the "
+          f"{len(typ)} non-ideal units (the ideal unit in brackets where it is not ~0); zeros = "
+          "readings of 0 at that constant speed, all units. **Bold**: the best method at that "
+          "speed (and any within 5 % of it).", "",
+          "| rpm | " + " | ".join(LABEL[v] for v in VARIANTS) + " | zeros M | zeros M/T A↑ |",
+          "|---:|" + "---:|" * (len(VARIANTS) + 2)]
+    for rpm in rpms:
+        rows = C[rpm]
+        cells = []
+        vals = {v: worst(rows, f"{v[0]}/{v[1]}", "rms", typ) if typ else
+                worst(rows, f"{v[0]}/{v[1]}", "rms") for v in VARIANTS}
+        best = min((x for x in vals.values() if not math.isnan(x)), default=math.nan)
+        for v in VARIANTS:
+            c = fmt_pct(vals[v], 2)
+            ideal = rows.get("ideal", {}).get(f"{v[0]}/{v[1]}", {}).get("rms", math.nan)
+            if not math.isnan(ideal) and ideal > 1e-4:
+                c += f" ({fmt_pct(ideal, 2)})"
+            cells.append(f"**{c}**" if vals[v] <= 1.05 * best else c)
+        zm = sum(r.get("M/any", {}).get("zeros", 0) for r in rows.values())
+        zmt = sum(r.get("MT/a_rising", {}).get("zeros", 0) for r in rows.values())
+        n = sum(r.get("MT/a_rising", {}).get("n", 0) for r in rows.values())
+        L.append(f"| {rpm:g} | " + " | ".join(cells) + f" | {zm}/{n} | {zmt}/{n} |")
+    L.append("")
+    # state width: why unlike edges are a poor source
+    L += ["## Why timing between unlike edges is a poor velocity source", "",
+          "An x4 encoder's four edges per cycle are not equally spaced: the state-width error ΔS "
+          "(tens of electrical degrees on a typical HEDS-5000, from the pulse-width and phase "
+          "errors) makes one state up to (90 + ΔS) e° long and another (90 − ΔS) e°. Timing "
+          "between consecutive edges of *any* type measures one state, so a reading is off by "
+          "up to ΔS / (90° − ΔS) -- at every speed, since it is geometry, not timing. A-rising edges are one "
+          "whole cycle apart: only the cycle error (line placement, ~0.7 e° rms) and the "
+          "once-per-revolution eccentricity remain. M/T with any edge averages the states over "
+          "the read period, so its error falls as more states fit in a read (≈ ΔS / 90° divided "
+          "by the states per read).", "",
+          "| unit | ΔS (e°) | ΔS / (90° − ΔS) (%) | T any edge max (%) | T A↑ max (%) | M/T any max at 30 rpm (%) "
+          "| M/T A↑ max at 30 rpm (%) |", "|---|---:|---:|---:|---:|---:|---:|"]
+    r30 = min(rpms, key=lambda r: abs(r - 30))
+    for n, _ in units:
+        s = usum[n]
+        t_any = max(C[r][n].get("T/any", {}).get("floor_max", 0) for r in rpms)
+        t_a = max(C[r][n].get("T/a_rising", {}).get("floor_max", 0) for r in rpms)
+        L.append(f"| {n} | {s['state_error_deg']:.1f} | {fmt_pct(s['state_error_deg'] / (90 - s['state_error_deg']), 1)} | "
+                 f"{fmt_pct(t_any, 2)} | {fmt_pct(t_a, 2)} | "
+                 f"{fmt_pct(C[r30][n].get('MT/any', {}).get('floor_max'), 2)} | "
+                 f"{fmt_pct(C[r30][n].get('MT/a_rising', {}).get('floor_max'), 2)} |")
+    L.append("")
+    # floor vs added, M/T A-rising
+    L += ["## Timestamp method, A-rising edges: the encoder's floor and what the hardware adds", "",
+          "| rpm | floor rms, worst unit (%) | floor max, worst unit (%) | added max, non-ideal (%) "
+          "| added max, ideal (%) | latched max, worst unit (%) | zeros |",
+          "|---:|---:|---:|---:|---:|---:|---:|"]
+    for rpm in rpms:
+        rows = C[rpm]
+        k = "MT/a_rising"
+        zeros = sum(r.get(k, {}).get("zeros", 0) for r in rows.values())
+        L.append(f"| {rpm:g} | {fmt_pct(worst(rows, k, 'floor_rms'))} | "
+                 f"{fmt_pct(worst(rows, k, 'floor_max'))} | "
+                 f"{fmt_pct(worst(rows, k, 'added_max', typ))} | "
+                 f"{fmt_pct(rows.get('ideal', {}).get(k, {}).get('added_max'))} | "
+                 f"{fmt_pct(worst(rows, k, 'max'))} | {zeros} |")
+    L.append("")
+    # prescaler
+    P = model["prescale"]
+    if P:
+        L += ["## Timebase resolution: hardware-added error of M/T A↑ vs prescaler", "",
+              f"Max added error (%), {units[0][0]} unit / {units[1][0] if len(units) > 1 else '-'}, "
+              f"at a {args.clk_mhz:g} MHz clock.", "",
+              "| PRESCALE | tick | " + " | ".join(f"{r:g} rpm" for r in PRESCALE_RPMS) + " |",
+              "|---:|---:|" + "---:|" * len(PRESCALE_RPMS)]
+        for p in sorted(P):
+            tick = (p + 1) / (args.clk_mhz * 1e6)
+            cells = []
+            for r in PRESCALE_RPMS:
+                rows = P[p].get(r, {})
+                vals = [rows[u]["MT/a_rising"]["added_max"] for u, _ in units[:2]
+                        if u in rows and "MT/a_rising" in rows[u]]
+                cells.append(" / ".join(fmt_pct(v) for v in vals))
+            L.append(f"| {p} | {tick * 1e9:g} ns | " + " | ".join(cells) + " |")
+        L += ["", "The added error is about one tick over the time between the two timestamps "
+              "(≥ one read period, 1 ms, when edges are dense; one cycle when they are sparse): "
+              "keep the tick ≤ 100 ns (PRESCALE ≤ 9 at 100 MHz) for ≤ 0.01 %.", ""]
+    # scenarios
+    S = model["scenario"]
+    if S:
+        L += ["## Ramp, reversal and stop", ""]
+        for sname in ("ramp", "reversal"):
+            if sname not in S:
+                continue
+            L += [f"**{SCENARIOS[sname][1]}**: rms / max error (%) where |true| ≥ 30 rpm "
+                  "(against the speed at the read; the methods' lag included), readings of the "
+                  "wrong sign and of 0 where |true| ≥ 6 rpm (after a turn, a reading keeps the "
+                  "old sign, decaying, until the first count step back: the encoder has not "
+                  "said anything yet).", "",
+                  "| unit | " + " | ".join(LABEL[v] for v in VARIANTS) + " |",
+                  "|---|" + "---|" * len(VARIANTS)]
+            for n, _ in units:
+                r = S[sname][n]
+                cells = []
+                for v in VARIANTS:
+                    m = r.get(f"{v[0]}/{v[1]}", {})
+                    cells.append(f"{fmt_pct(m.get('rms'), 2)} / {fmt_pct(m.get('max'), 2)}; "
+                                 f"sign {m.get('wrong_sign', 0)}, 0s {m.get('zeros_moving', 0)}"
+                                 f"/{m.get('n_moving', 0)}")
+                L.append(f"| {n} | " + " | ".join(cells) + " |")
+            L.append("")
+        for sname in ("stop", "stop6"):
+            if sname not in S:
+                continue
+            L += [f"**{SCENARIOS[sname][1]}**: time from the stop until the reading is 0 for good "
+                  f"(s) [from the last edge of any type]; zero readings while turning.", "",
+                  "| unit | " + " | ".join(LABEL[v] for v in VARIANTS) + " |",
+                  "|---|" + "---|" * len(VARIANTS)]
+            for n, _ in units:
+                r = S[sname][n]
+                cells = []
+                for v in VARIANTS:
+                    m = r.get(f"{v[0]}/{v[1]}", {})
+                    cells.append(f"{m.get('t_to_zero_s', math.nan):.3f} "
+                                 f"[{m.get('since_last_edge_s', math.nan):.3f}]; 0s "
+                                 f"{m.get('zeros_moving', 0)}/{m.get('n_moving', 0)}")
+                L.append(f"| {n} | " + " | ".join(cells) + " |")
+            L.append("")
+    # sim
+    L += ["## Through the RTL (enc_qei_wb over Wishbone, cocotb)", ""]
+    if sim is None:
+        L += ["Not run (`--sim none`).", ""]
+    elif sim.get("skipped"):
+        L += [f"**Not run**: {sim['skipped']}. The numbers above are the model layer only "
+              "(an ideal peripheral with the contract's timing).", ""]
+    else:
+        L += sim["lines"]
+    # goals
+    verdicts = goals(args, units, model, sim)
+    L += ["## Goals (issue 13)", ""] + [f"- {v}" for v in verdicts] + [""]
+    L += ["## Recommendation", "",
+          "- Use **M/T on A-rising edges** (SNAP_CTRL.EDGE = a_rising, SNAP_EDGE_DELTA / Δ "
+          "SNAP_EDGE_TIME) at every speed: its error is the encoder's own (cycle error and "
+          "eccentricity, ~0.1–0.3 % rms on a typical unit, the once-per-revolution eccentricity "
+          "term dominating above ~300 rpm) and the standstill rule keeps it off 0 down to one "
+          "cycle per stall timeout.",
+          "- **Any-edge timing** only helps when many states fit in one reading (M/T any edge "
+          "above ~3,000 rpm, where it equals A↑); below that it inherits ΔS / 90° per edge pair.",
+          "- **M** (unit time) is exact on average but quantised to one count per read period "
+          "(30 rpm at 1 kHz): 0 or 30 rpm below 30 rpm, ±1 count in the reading above.",
+          "- **T** (one edge period) on A-rising edges is a good low-speed method (one cycle), but "
+          "at high speed it sees one cycle's error, unaveraged: prefer M/T there.", ""]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(L))
+    return verdicts
+
+
+def goals(args, units, model, sim) -> list[str]:
+    C = model["constant"]
+    out = []
+    band = [r for r in model["rpms"] if GOAL_BAND[0] <= r <= GOAL_BAND[1]]
+    k = "MT/a_rising"
+    typ = [n for n, _ in units if n != "ideal"]
+    if band:
+        a_typ = max((C[r][u][k]["added_max"] for r in band for u in typ if k in C[r][u]),
+                    default=math.nan)
+        a_id = max(C[r]["ideal"][k]["added_max"] for r in band if k in C[r]["ideal"])
+        out.append(f"{'MET' if a_typ <= GOAL_ADDED_TYP else 'MISSED'} (model): the timebase adds "
+                   f"at most {fmt_pct(a_typ, 4)} % to the floor of M/T A↑ on the non-ideal units "
+                   f"from {band[0]:g} to {band[-1]:g} rpm (goal ≤ 0.1 %).")
+        out.append(f"{'MET' if a_id <= GOAL_ADDED_IDEAL else 'MISSED'} (model): at most "
+                   f"{fmt_pct(a_id, 4)} % on the ideal unit (goal ≤ 0.02 %).")
+    low = [r for r in model["rpms"] if r >= GOAL_NONZERO_RPM]
+    z = sum(C[r][u].get(k, {}).get("zeros", 0) for r in low for u in C[r])
+    zt = sum(C[r][u].get("T/a_rising", {}).get("zeros", 0) for r in low for u in C[r])
+    out.append(f"{'MET' if z == 0 else 'MISSED'} (model): {z} readings of 0 from M/T A↑ at "
+               f"constant speeds ≥ {GOAL_NONZERO_RPM:g} rpm (T A↑: {zt}; M reads 0 below "
+               "30 rpm by design).")
+    S = model["scenario"]
+    stall = args.stall_ms * 1e-3
+    for sname in ("stop", "stop6"):
+        if sname in S:
+            t = max(S[sname][u][k]["t_to_zero_s"] for u in S[sname])
+            out.append(f"{'MET' if t <= stall + 1.5 / READ_HZ else 'MISSED'} (model): after "
+                       f"the stop in '{SCENARIOS[sname][1]}', M/T A↑ reads 0 within {t * 1e3:.0f} "
+                       f"ms at worst (stall timeout {args.stall_ms:g} ms, counted from the last "
+                       "edge, which comes before the stop).")
+    if sim and not sim.get("skipped"):
+        out += sim.get("goals", [])
+    elif sim and sim.get("skipped"):
+        out.append(f"NOT CHECKED through the RTL: {sim['skipped']}.")
+    return out
+
+
+def write_figure(args, units, model, sim, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    C, rpms = model["constant"], model["rpms"]
+    fig, axes = plt.subplots(2, 3, figsize=(15, 8.5), dpi=110, sharex=True)
+    axes = axes.ravel()
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ax, v in zip(axes, VARIANTS):
+        key = f"{v[0]}/{v[1]}"
+        for i, (n, _) in enumerate(units):
+            c = colours[i % len(colours)]
+            hw = [max(C[r][n].get(key, {}).get("rms", np.nan), 1e-7) for r in rpms]
+            fl = [max(C[r][n].get(key, {}).get("floor_rms", np.nan), 1e-7) for r in rpms]
+            ax.plot(rpms, 100 * np.array(hw), "-o", ms=3, color=c, lw=1.3, label=f"{n}")
+            ax.plot(rpms, 100 * np.array(fl), "--", color=c, lw=0.9, alpha=0.8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(LABEL[v], fontsize=11)
+        ax.set_ylim(1e-5, 1e4)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.axvline(30, color="grey", lw=0.6, ls=":")
+    ax = axes[5]
+    key = "MT/a_rising"
+    for i, (n, _) in enumerate(units):
+        c = colours[i % len(colours)]
+        ad = [max(C[r][n].get(key, {}).get("added_max", np.nan), 1e-7) for r in rpms]
+        ax.plot(rpms, 100 * np.array(ad), "-o", ms=3, color=c, lw=1.3, label=n)
+    if sim and not sim.get("skipped") and sim.get("points"):
+        pts = sim["points"]
+        ax.scatter([p["rpm"] for p in pts], [max(100 * p["added_max"], 1e-5) for p in pts],
+                   marker="x", color="k", s=30, zorder=5, label="through the RTL (sim)")
+    ax.axhline(100 * GOAL_ADDED_TYP, color="r", lw=0.8, ls="--", label="goal 0.1 %")
+    ax.axhline(100 * GOAL_ADDED_IDEAL, color="r", lw=0.8, ls=":", label="goal 0.02 % (ideal)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(1e-5, 1)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.set_title("M/T A↑: max error added by the timebase", fontsize=11)
+    ax.legend(fontsize=7, loc="upper right")
+    axes[0].legend(fontsize=7, loc="lower left", title="solid: latched, dashed: floor",
+                   title_fontsize=7)
+    for ax in axes[3:]:
+        ax.set_xlabel("shaft speed (rpm)")
+    for ax in axes[::3]:
+        ax.set_ylabel("relative error, % (rms)")
+    tb = timebase(args)
+    fig.suptitle(f"Velocity methods on modelled HEDS-5000 units, 1 kHz reads, "
+                 f"{tb.tick_s * 1e9:g} ns timebase (seed {args.seed})", fontsize=12)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+# ----------------------------------------------------------------------------- main
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    t_start = time.perf_counter()
+    units = make_units(args)
+    usum = {n: unit_summary(u) for n, u in units}
+    for n, _ in units:
+        s = usum[n]
+        print(f"unit {n}: state-width error {s['state_error_deg']:.1f} e°, phase "
+              f"{s['phase_error_deg']:.1f} e°, eccentricity {s['ecc_mm']:.4f} mm TIR", flush=True)
+    model = run_model(args, units)
+    print(f"model layer: {model['wall_s']:.1f} s", flush=True)
+    sim = None
+    if args.sim != "none":
+        ok, why = rtl_has_timing()
+        if not ok:
+            sim = {"skipped": f"enc_qei's timing registers are not in the RTL yet ({why})"}
+            print(f"sim layer skipped: {sim['skipped']}", flush=True)
+        else:
+            sim = run_sim(args, units, model["rpms"])
+    wall = time.perf_counter() - t_start
+    verdicts = write_table(args, units, usum, model, sim, TABLE, wall)
+    write_figure(args, units, model, sim, FIGURE)
+    print(f"wrote {TABLE.relative_to(TOP)} and {FIGURE.relative_to(TOP)} in {wall / 60:.1f} min")
+    for v in verdicts:
+        print("  " + v)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
