@@ -37,6 +37,8 @@ Options:
   --only M[,M]     just these modules
   --list           print the module/corner/test mapping and exit
   --keep           keep the build directories of killed mutants too
+  --mutation CMD   run given mutations instead (with one --only module): how the deterministic
+                   tests were shown to kill the mutants of issue 14, see doc/mutation.md
 """
 
 from __future__ import annotations
@@ -301,15 +303,20 @@ def add_params(verilog: str, c: Corner) -> str:
     return verilog[:m.end()] + param_decls(c) + verilog[m.end():]
 
 
-def generate(root: Path, c: Corner, n: int, seed: int) -> list[Mutant]:
-    """Elaborate at the corner, list n mutations, write the unmutated round trip (m00) and each
-    mutant as Verilog."""
+def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None = None) -> list[Mutant]:
+    """Elaborate at the corner, list n mutations (or take the `given` mutate commands), write the
+    unmutated round trip (m00) and each mutant as Verilog."""
     d = corner_dir(root, c)
     d.mkdir(parents=True, exist_ok=True)
     rel = d.relative_to(TOP)
     script = (elaborate_script(c)
-              + f"select {c.module}\nwrite_rtlil -selected {rel}/orig.il\nselect -clear\n"
-              + f"mutate -list {n} -seed {seed} -o {rel}/list.ys {c.module}\n")
+              + f"select {c.module}\nwrite_rtlil -selected {rel}/orig.il\nselect -clear\n")
+    if given is None:
+        script += f"mutate -list {n} -seed {seed} -o {rel}/list.ys {c.module}\n"
+    else:
+        (d / "list.ys").write_text("".join(
+            (g if " -module " in g else g.replace("mutate ", f"mutate -module {c.module} ", 1)) + "\n"
+            for g in given))
     proc = run_yosys(script, d / "list.log")
     if proc.returncode != 0:
         raise RuntimeError(f"{c.module} {c.label}: Yosys elaboration/mutate -list failed:\n"
@@ -358,7 +365,11 @@ def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: fl
     (build / "pytest.log").parent.mkdir(parents=True, exist_ok=True)
     (build / "pytest.log").write_text(out)
     failed = re.findall(r"^FAILED (\S+)", out, re.M)
-    return proc.returncode == 0, False, seconds, failed[0] if failed else ""
+    what = failed[0].split("::")[-1] if failed else ""
+    cocotb_failed = sorted(set(re.findall(r"\*\* \S+?\.(\w+)\s+FAIL\b", out)))
+    if cocotb_failed:
+        what += f" ({', '.join(cocotb_failed)})"
+    return proc.returncode == 0, False, seconds, what
 
 
 def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
@@ -420,6 +431,10 @@ def main() -> int:
     ap.add_argument("--only", default="", help="comma-separated modules")
     ap.add_argument("--list", action="store_true")
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--mutation", action="append", default=[], metavar="CMD",
+                    help="run this `mutate -mode ... -cell ...` command (repeatable) instead of "
+                    "mutate -list, on the one --only module at each of its corners; cell names "
+                    "as in build/mutate/seed*/<module>_<corner>/orig.il")
     ap.add_argument("--no-results", action="store_true", help="do not write doc/results/mutation.md")
     args = ap.parse_args()
     if args.jobs < 1:
@@ -430,6 +445,10 @@ def main() -> int:
         if m not in MODULES:
             ap.error(f"unknown module {m!r}; known: {', '.join(MODULES)}")
     modules = only or list(MODULES)
+    if args.mutation and len(only) != 1:
+        ap.error("--mutation needs exactly one module in --only")
+    if args.mutation:
+        args.no_results = True
     corners = [Corner(mod, params, tests, i)
                for mod in modules for i, (params, tests) in enumerate(MODULES[mod]["corners"])]
     if args.list:
@@ -439,7 +458,7 @@ def main() -> int:
         return 0
 
     t_start = time.monotonic()
-    root = TOP / BUILD_REL / f"seed{args.seed}"
+    root = TOP / BUILD_REL / (f"seed{args.seed}" if not args.mutation else "given")
     if root.exists():
         shutil.rmtree(root)
     root.mkdir(parents=True)
@@ -453,7 +472,7 @@ def main() -> int:
 
     def gen(c: Corner) -> list[Mutant]:
         n = args.n or MODULES[c.module].get("n", DEFAULT_N)
-        return generate(root, c, n, args.seed)
+        return generate(root, c, n, args.seed, args.mutation or None)
 
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         for c, ms in zip(corners, pool.map(gen, corners)):
@@ -494,7 +513,7 @@ def main() -> int:
             m.result = "timeout"
         elif not ok:
             m.result = "killed"
-            m.failed_test = failed.split("::")[-1]
+            m.failed_test = failed
         else:
             eq, note = equivalence(root, m)
             m.result = "equivalent" if eq else "survived"

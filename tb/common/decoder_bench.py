@@ -212,6 +212,34 @@ async def x1_hysteresis_bound(dut):
     await play_samples(dut, random_walk(rng, 3000), bound=4)
 
 
+@cocotb.test()
+async def reset_then_illegal_jump(dut):
+    """A one-clock reset followed at once, on the first clock after it, by a jump of either channel
+    or of both (the illegal two-channel change): that first sample is only the new reference, so
+    no count and no error pulse; then a short run is counted from it. From every state, for
+    every step, and with the decoder's internal state before the reset varied (a run of k steps
+    in either direction: a latched hysteresis state, a pending count). Deterministic: it catches
+    an `error` (or count) that ignores the reference flag on every seed (mutation run, issue 14)."""
+    await start(dut)
+    model = model_for(dut)
+    for start_pos in range(4):
+        for before in (0, 3, -3, 6):
+            for jump in (2, -2, 1, -1):
+                s = Samples(start_pos)
+                s.reset()
+                s.hold(1)
+                for _ in range(abs(before)):
+                    s.move(1 if before > 0 else -1, 1)
+                s.reset()  # rst during one clock, inputs held
+                s.move(jump, 1)  # the first sample after the reset differs in one or both channels
+                s.hold(1)
+                for _ in range(5):
+                    s.move(1 if jump > 0 else -1, 1)
+                s.hold(2)
+                # no |4n - p| bound here: the jump's two steps are before the reference
+                await play_samples(dut, s, model)
+
+
 # cocotb tests every decoder runs (enc_x1_hysteresis adds x1_hysteresis_bound)
 COMMON_TESTS = ("random_walk_20k,reset_mid_motion,reversal_at_every_state,dither_every_transition,"
                 "monotone_runs")

@@ -10,7 +10,7 @@ from harness import run
 
 def test_enc_x1_hysteresis():
     run("enc_x1_hysteresis", "decoder_bench", name="enc_x1_hysteresis",
-        testcase=COMMON_TESTS + ",x1_hysteresis_bound")
+        testcase=COMMON_TESTS + ",x1_hysteresis_bound,reset_then_illegal_jump")
 
 
 def test_naive_x1_fails_hysteresis():
