@@ -26,6 +26,25 @@ if [ ${#need_pkgs[@]} -gt 0 ]; then
   fi
 fi
 
+# Optional: GTKWave and Xvfb, for `make waves` and the headless GTKWave check of the demo's save
+# file (tb/demo/test_gtkwave.py, skipped without them). A failure here is a note, not an error.
+opt_pkgs=()
+command -v gtkwave  >/dev/null 2>&1 || opt_pkgs+=(gtkwave)
+command -v xvfb-run >/dev/null 2>&1 || opt_pkgs+=(xvfb)
+if [ ${#opt_pkgs[@]} -gt 0 ]; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "bootstrap: installing optional ${opt_pkgs[*]} with apt-get"
+    # APT::Sandbox::User=root: in containers where /dev/null is not writable by apt's _apt user,
+    # 'apt-get update' otherwise fails its signature check
+    apt=(apt-get -o APT::Sandbox::User=root)
+    if ! { "${apt[@]}" update -qq && DEBIAN_FRONTEND=noninteractive "${apt[@]}" install -y -qq "${opt_pkgs[@]}"; } >/tmp/bootstrap-apt-optional.log 2>&1; then
+      echo "bootstrap: note: optional ${opt_pkgs[*]} not installed (see /tmp/bootstrap-apt-optional.log); GTKWave review and its test are skipped"
+    fi
+  else
+    echo "bootstrap: note: optional packages for waveform review not installed: ${opt_pkgs[*]} (e.g. 'sudo apt-get install ${opt_pkgs[*]}')"
+  fi
+fi
+
 py=$(command -v python3) || { echo "bootstrap: python3 (3.9 or newer) is required" >&2; exit 1; }
 "$py" -c 'import sys; sys.exit(sys.version_info < (3, 9))' \
   || { echo "bootstrap: python3 is $("$py" --version 2>&1); 3.9 or newer is required" >&2; exit 1; }

@@ -15,9 +15,12 @@ What it does:
   4. Prints one table: the true position against every count, the phase meter against the model's
      true phase over the same cycles, the characterizer against the model, the narrowest state
      against the decoder's limit, and a verdict per circuit. Exit status 1 if any verdict fails.
-  5. Leaves sim/waves/demo.vcd (open it with sim/demo.gtkw: ``make waves``) and renders a short
-     window of it to sim/waves/demo_waves.png (``--png`` to choose the file; the README picture
-     is ``--png sim/figures/demo_waves.png`` with the default options).
+  5. Leaves sim/waves/demo.vcd and a GTKWave save file for it, sim/waves/demo.gtkw (``make
+     waves`` opens both): sim/demo.gtkw's signals, opening on three encoder cycles at the peak
+     speed of this run, markers A to D on the rising edges of A that bound them (``--gtkw`` to
+     choose the file; sim/demo.gtkw itself is ``--gtkw sim/demo.gtkw`` with the default options).
+     Renders a short window of the VCD to sim/waves/demo_waves.png (``--png`` to choose the file;
+     the README picture is ``--png sim/figures/demo_waves.png`` with the default options).
 
 Options (``make demo RPM=... TEMP_C=... CLK_HZ=... SEED=...``; an empty value means the default):
   --rpm     peak shaft speed, rpm (default 3000); the reverse speed is -rpm/5
@@ -26,8 +29,9 @@ Options (``make demo RPM=... TEMP_C=... CLK_HZ=... SEED=...``; an empty value me
   --seed    non-negative integer (default 1)
 A bad value stops the demo with a one-line message before anything is built or simulated.
 
-``--waves`` (``make waves``): open sim/waves/demo.vcd with sim/demo.gtkw in GTKWave when there
-is a display and gtkwave is installed, otherwise print where the files are and the command.
+``--waves`` (``make waves``): open sim/waves/demo.vcd with its save file (sim/waves/demo.gtkw,
+else sim/demo.gtkw) in GTKWave when there is a display and gtkwave is installed, otherwise print
+where the files are and the command.
 """
 
 from __future__ import annotations
@@ -54,6 +58,14 @@ NAME = "demo"
 VCD = TOP / "sim" / "waves" / "demo.vcd"
 GTKW = TOP / "sim" / "demo.gtkw"
 DEFAULT_PNG = TOP / "sim" / "waves" / "demo_waves.png"
+# The save file's view: GTKW_CYCLES cycles at the peak speed from the first rising edge of A after
+# the middle of the hold (where the README picture's left panel starts), with half a cycle either
+# side. GTKWave's zoom is time per pixel, so the visible span follows the window: GTKW_WAVE_PX is
+# the width of GTKWave 3.3's wave pane at the save file's [size] (measured under Xvfb; the signal
+# pane takes the rest). A window narrower by up to a quarter still shows the three cycles.
+GTKW_CYCLES = 3
+GTKW_VIEW_CYCLES = GTKW_CYCLES + 1.0
+GTKW_WAVE_PX = 800
 README_PNG = TOP / "sim" / "figures" / "demo_waves.png"
 
 # ---------------------------------------------------------------------------------------------
@@ -207,6 +219,9 @@ def parse_args(argv=None):
                          "build; Verilator, faster per clock, for long ones)")
     ap.add_argument("--png", default=str(DEFAULT_PNG),
                     help="where to render the waveform picture ('' = none)")
+    ap.add_argument("--gtkw", default=None,
+                    help="where to write the GTKWave save file for this run (default "
+                         "sim/waves/NAME.gtkw beside the VCD; '' = none)")
     ap.add_argument("--waves", action="store_true", help="open the demo's VCD in GTKWave")
     ap.add_argument("--name", default=NAME, help=argparse.SUPPRESS)  # build dir and VCD name (tests)
     args = ap.parse_args(argv)
@@ -662,10 +677,69 @@ def print_report(plan: Plan, res: dict, an: dict) -> None:
 
 
 # ---------------------------------------------------------------------------------------------
+# GTKWave save file
+# ---------------------------------------------------------------------------------------------
+def gtkw_view(plan: Plan) -> dict:
+    """The save file's view of this run, in simulation ps (``plan.t0_ps`` set from the bench):
+    ``rises`` the GTKW_CYCLES + 1 rising edges of A (the encoder's output) that bound the cycles,
+    ``start``/``end`` the span meant to be visible, ``zoom`` GTKWave's zoom for it."""
+    tau_ps = 1e12 / (plan.opts.rpm / 60.0 * CPR)
+    h0, h1 = plan.seg["hold"]
+    mid = plan.t0_ps + (h0 + h1) / 2 * 1000.0
+    rises = [int(round(t)) for t, _ in _a_rises(plan.wf, plan.t0_ps) if t >= mid][:GTKW_CYCLES + 1]
+    start = int(rises[0] - (GTKW_VIEW_CYCLES - GTKW_CYCLES) / 2 * tau_ps)
+    end = int(start + GTKW_VIEW_CYCLES * tau_ps)
+    # GTKWave 3.3: time per pixel = 2 ** -zoom / 200 (its 200 pixels per zoom frame)
+    zoom = -math.log2((end - start) * 200.0 / GTKW_WAVE_PX)
+    return {"rises": rises, "start": start, "end": end, "zoom": zoom, "tau_ps": tau_ps}
+
+
+def gtkw_text(plan: Plan, vcd: Path, gtkw: Path) -> str:
+    """sim/demo.gtkw (signals, groups, layout) with this run's dump file and view: timestart and
+    zoom from gtkw_view, named markers A.. on the rising edges of A that bound the cycles."""
+    v = gtkw_view(plan)
+    o = plan.opts
+    named = v["rises"] + [-1] * (26 - len(v["rises"]))
+    out = []
+    for line in GTKW.read_text().splitlines():
+        if line.startswith("[*] Opens on"):
+            line = (f"[*] Opens on {GTKW_CYCLES} encoder cycles at {o.rpm:g} rpm ({o.temp_c:g} degC, "
+                    f"{o.clk_hz / 1e6:g} MHz clock, seed {o.seed}), markers A-"
+                    f"{chr(ord('A') + GTKW_CYCLES)} on A's rising edges; Zoom Full: the whole run.")
+        elif line.startswith("[dumpfile]"):
+            line = f'[dumpfile] "{os.path.relpath(vcd, gtkw.parent)}"'
+        elif line.startswith("[savefile]"):
+            line = f'[savefile] "{gtkw.name}"'
+        elif line.startswith("[timestart]"):
+            line = f"[timestart] {v['start']}"
+        elif line.startswith("*"):
+            # zoom, primary marker (none), then the named markers A..Z
+            line = f"*{v['zoom']:.6f} -1 " + " ".join(str(t) for t in named)
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def write_gtkw(plan: Plan, vcd: Path, gtkw: Path) -> None:
+    text = gtkw_text(plan, vcd, gtkw)
+    gtkw.parent.mkdir(parents=True, exist_ok=True)
+    gtkw.write_text(text)
+
+
+def gtkw_view_lines(text: str) -> list:
+    """A save file's lines less its own and its dump's name: equal for two files with one view."""
+    return [ln for ln in text.splitlines() if not ln.startswith(("[dumpfile]", "[savefile]"))]
+
+
+# ---------------------------------------------------------------------------------------------
 # make waves
 # ---------------------------------------------------------------------------------------------
 def open_waves() -> int:
-    rel_vcd, rel_gtkw = VCD.relative_to(TOP), GTKW.relative_to(TOP)
+    # sim/demo.gtkw, whose view is the default run's; after a run with other options, the save file
+    # written with its dump (same signals, the view of that run)
+    gtkw, run_gtkw = GTKW, VCD.with_suffix(".gtkw")
+    if run_gtkw.exists() and gtkw_view_lines(run_gtkw.read_text()) != gtkw_view_lines(GTKW.read_text()):
+        gtkw = run_gtkw
+    rel_vcd, rel_gtkw = VCD.relative_to(TOP), gtkw.relative_to(TOP)
     cmd = ["gtkwave", str(rel_vcd), str(rel_gtkw)]
     if not VCD.exists():
         print(f"waves: {rel_vcd} does not exist yet; run 'make demo' first, then: {' '.join(cmd)}")
@@ -703,15 +777,21 @@ def main(argv=None) -> int:
     an = analyze(plan, res)
     print_report(plan, res, an)
     vcd_mb = vcd.stat().st_size / 1e6 if vcd.exists() else 0.0
+    gtkw = vcd.with_suffix(".gtkw") if args.gtkw is None else Path(args.gtkw) if args.gtkw else None
+    shown = ""
+    if gtkw is not None:
+        gtkw = gtkw if gtkw.is_absolute() else Path.cwd() / gtkw
+        write_gtkw(plan, vcd, gtkw)
+        shown = f", save file {gtkw.relative_to(TOP) if gtkw.is_relative_to(TOP) else gtkw}"
     if args.png:
         import vcd_to_png
         png = Path(args.png)
         png = png if png.is_absolute() else Path.cwd() / png
         vcd_to_png.demo_figure(vcd, png, plan)
-        print(f"waves: {vcd.relative_to(TOP)} ({vcd_mb:.1f} MB), picture {png.relative_to(TOP) if png.is_relative_to(TOP) else png}; "
+        print(f"waves: {vcd.relative_to(TOP)} ({vcd_mb:.1f} MB){shown}, picture {png.relative_to(TOP) if png.is_relative_to(TOP) else png}; "
               f"'make waves' opens them")
     else:
-        print(f"waves: {vcd.relative_to(TOP)} ({vcd_mb:.1f} MB); 'make waves' opens it")
+        print(f"waves: {vcd.relative_to(TOP)} ({vcd_mb:.1f} MB){shown}; 'make waves' opens it")
     n_fail = sum(not ok for _, ok, _ in an["verdicts"])
     print(f"demo: {'all circuits PASS' if not n_fail else f'{n_fail} FAIL'} "
           f"(build {res['t_build']:.1f} s, simulation {res['t_sim']:.1f} s, "
