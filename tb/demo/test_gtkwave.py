@@ -78,21 +78,23 @@ def short_run():
     vcd = TOP / "sim" / "waves" / f"{NAME}.vcd"
     gtkw = vcd.with_suffix(".gtkw")
     build = TOP / "sim" / "build" / "icarus" / NAME
-    env = dict(os.environ, PATH=harness.tool_env_path())
-    t = time.monotonic()
-    r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", str(RPM),
-                        "--sim", "icarus", "--name", NAME, "--png", ""],
-                       capture_output=True, text=True, timeout=300, env=env, cwd=TOP)
-    # exit status 1 is a failed verdict (test_demo.py's business); the dump and save file are
-    # written all the same
-    assert r.returncode in (0, 1) and vcd.exists() and gtkw.exists(), \
-        r.stdout[-3000:] + r.stderr[-3000:]
-    print(f"short demo run: {time.monotonic() - t:.1f} s")
-    res = json.loads((build / "result.json").read_text())
-    yield {"vcd": vcd, "gtkw": gtkw, "res": res}
-    vcd.unlink(missing_ok=True)
-    gtkw.unlink(missing_ok=True)
-    shutil.rmtree(build, ignore_errors=True)
+    try:
+        env = dict(os.environ, PATH=harness.tool_env_path())
+        t = time.monotonic()
+        r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", str(RPM),
+                            "--sim", "icarus", "--name", NAME, "--png", ""],
+                           capture_output=True, text=True, timeout=300, env=env, cwd=TOP)
+        # exit status 1 is a failed verdict (test_demo.py's business); the dump and save file are
+        # written all the same
+        assert r.returncode in (0, 1) and vcd.exists() and gtkw.exists(), \
+            r.stdout[-3000:] + r.stderr[-3000:]
+        print(f"short demo run: {time.monotonic() - t:.1f} s")
+        res = json.loads((build / "result.json").read_text())
+        yield {"vcd": vcd, "gtkw": gtkw, "res": res}
+    finally:
+        vcd.unlink(missing_ok=True)
+        gtkw.unlink(missing_ok=True)
+        shutil.rmtree(build, ignore_errors=True)
 
 
 def test_checked_in_save_file_is_the_default_runs(short_run):
