@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: Apache-2.0
+"""scripts/velocity_bench.py: argument checks (one-line errors), and the simulated layer's
+analysis fed with the registers an ideal enc_qei would give (from hedsmodel.velocity's
+snapshot_trace), so the edge matching and the consistency checks are known to work before the
+RTL's timing registers exist: no inconsistency, and what the timebase adds equals the model
+layer's figure."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hedsmodel import EncoderUnit
+from hedsmodel.velocity import Timebase, snapshot_trace
+
+TOP = Path(__file__).resolve().parents[2]
+SCRIPT = TOP / "scripts" / "velocity_bench.py"
+
+
+@pytest.fixture(scope="module")
+def bench():
+    spec = importlib.util.spec_from_file_location("velocity_bench", SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("argv,fragment", [
+    (["--rpm-min", "0"], "--rpm-min"),
+    (["--rpm-min", "100", "--rpm-max", "50"], "must be below --rpm-max"),
+    (["--units", "-1"], "--units"),
+    (["--seed", "x"], "--seed"),
+    (["--jobs", "0"], "--jobs"),
+    (["--quick", "yes"], "unrecognized arguments"),
+    (["--prescale", "70000"], "--prescale"),
+    (["--prescale", "20000"], "too coarse"),
+    (["--sim", "modelsim"], "--sim"),
+])
+def test_bad_arguments_give_one_line(argv, fragment):
+    res = subprocess.run([sys.executable, str(SCRIPT), *argv], capture_output=True, text=True,
+                         timeout=60)
+    assert res.returncode == 2, res
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("velocity_bench: ") and fragment in lines[0], \
+        res.stderr
+
+
+def fake_raw(case, tb: Timebase, start_s: float, bits: dict):
+    """What velocity_bench_sim.py would record from an ideal enc_qei (clock 0 at sim time 0,
+    the waveform started at ``start_s``, a multiple of the clock period)."""
+    clk = 1 / tb.clk_hz
+    k0 = int(round(start_s / clk))
+    tbx = Timebase(clk_hz=tb.clk_hz, prescale=tb.prescale, ts_w=32,
+                   latency_clocks=tb.latency_clocks, tb_offset=k0)
+    reads = np.array(case["reads_ns"]) * 1e-9
+    tr = snapshot_trace(case["wf"], 1000.0, case["edge_name"], 1, tbx, reads[0], reads[-1] + 1e-9)
+    cal_s = start_s - 30 * clk
+    out = []
+    for s, t in zip(tr.snaps, tr.t_read_s):
+        out.append({"t_ack_ps": (start_s + t) * 1e12, "SNAP_COUNT_LO": s.count,
+                    "SNAP_TIME": s.time, "SNAP_EDGE_TIME": s.edge_time,
+                    "SNAP_DELTA": s.delta & 0xFFFFFFFF, "SNAP_EDGE_DELTA": s.edge_delta & 0xFFFFFFFF,
+                    "PERIOD": s.period,
+                    "PERIOD_CTRL": (s.period_ovf << bits["PERIOD_CTRL.OVERFLOW"])
+                    | (s.period_dir_change << bits["PERIOD_CTRL.DIR_CHANGE"]),
+                    "STATUS": 0})
+    return {"t_start_ps": start_s * 1e12, "t_cal0_ps": cal_s * 1e12, "t_cal1_ps": cal_s * 1e12,
+            "tb_cal": (k0 - 30) // (tb.prescale + 1), "reads": out}
+
+
+def test_sim_analysis_on_ideal_registers(bench):
+    args = argparse.Namespace(quick=True, sim_reads=6, stall_ms=200.0, prescale=0, clk_mhz=100.0,
+                              seed=7, jobs=1)
+    regs, bits, a_rising = bench.reg_layout()
+    assert a_rising == 1 and "SNAP_EDGE_DELTA" in regs
+    units = [("ideal", EncoderUnit()), ("typical 1", EncoderUnit.typical(np.random.default_rng(7)))]
+    rng = np.random.default_rng(7)
+    cases = bench.sim_cases(args, units, [30.0, 394.0, 12000.0], rng)
+    tb = bench.timebase(args)
+    for c in cases:
+        raw = fake_raw(c, tb, start_s=0.0123, bits=bits)
+        r = bench.analyse_case(c, raw, args, tb, bits)
+        print(c["id"], r["latency_ticks"], r["checked"], {k: v.get("added_max")
+                                                         for k, v in r["methods"].items()})
+        assert r["unmatched"] == 0 and r["bad_edge_delta"] == 0 and r["bad_period"] == 0 \
+            and r["bad_delta"] == 0, r
+        assert r["checked"]["edge_delta"] > 0 and r["checked"]["delta"] > 0
+        assert abs(r["latency_ticks"] - tb.latency_clocks) <= 1.5
+        mt = r["methods"]["MT"]
+        assert mt["n"] >= 1, r
+        assert mt["added_max"] < 2e-4, r
+        assert mt["zeros"] == 0
