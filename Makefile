@@ -21,6 +21,9 @@ export ENC_WAVES := $(WAVES)
 # cocotb's runner reads WAVES itself and would switch Icarus to FST; we make VCD ourselves.
 unexport WAVES
 
+# demo and velocity pick the faster simulator themselves unless SIM is given on the command line
+SIM_OR_AUTO = $(if $(filter command line,$(origin SIM)),$(SIM),auto)
+
 .DEFAULT_GOAL := help
 
 .PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check
@@ -37,10 +40,10 @@ $(STAMP): requirements.txt scripts/bootstrap.sh
 venv: $(STAMP) ## create .venv from requirements.txt (done automatically by every target)
 
 demo: $(STAMP) ## the main job: a modeled HEDS-5000 drives every circuit (RPM= TEMP_C= CLK_HZ= SEED=)
-	@$(PY) scripts/demo.py --rpm "$(RPM)" --temp-c "$(TEMP_C)" --clk-hz "$(CLK_HZ)" --seed "$(SEED)"
+	@$(PY) scripts/demo.py --rpm "$(RPM)" --temp-c "$(TEMP_C)" --clk-hz "$(CLK_HZ)" --seed "$(SEED)" --sim $(SIM_OR_AUTO)
 
 waves: $(STAMP) ## open the demo's sim/waves/demo.vcd in GTKWave with sim/demo.gtkw (or say how)
-	@$(PY) scripts/demo.py --waves
+	@$(PY) scripts/demo.py --view
 
 test: $(STAMP) ## run the cocotb regression (SIM=icarus default, or SIM=verilator; WAVES=1 for VCDs)
 	@case "$(SIM)" in icarus|verilator) ;; *) echo "make test: SIM=$(SIM) is not supported; use SIM=icarus or SIM=verilator" >&2; exit 2;; esac
@@ -71,7 +74,7 @@ regs: $(STAMP) ## regenerate the enc_qei C header and register reference from rt
 	$(PY) scripts/gen_regs.py
 
 velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 units through enc_qei
-	$(PY) scripts/velocity_bench.py --jobs $(JOBS)
+	$(PY) scripts/velocity_bench.py --jobs $(JOBS) --sim $(SIM_OR_AUTO)
 
 package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
 	@bash scripts/check_package.sh

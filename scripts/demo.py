@@ -29,7 +29,7 @@ Options (``make demo RPM=... TEMP_C=... CLK_HZ=... SEED=...``; an empty value me
   --seed    non-negative integer (default 1)
 A bad value stops the demo with a one-line message before anything is built or simulated.
 
-``--waves`` (``make waves``): open sim/waves/demo.vcd with its save file (sim/waves/demo.gtkw,
+``--view`` (``make waves``): open sim/waves/demo.vcd with its save file (sim/waves/demo.gtkw,
 else sim/demo.gtkw) in GTKWave when there is a display and gtkwave is installed, otherwise print
 where the files are and the command.
 """
@@ -222,7 +222,7 @@ def parse_args(argv=None):
     ap.add_argument("--gtkw", default=None,
                     help="where to write the GTKWave save file for this run (default "
                          "sim/waves/NAME.gtkw beside the VCD; '' = none)")
-    ap.add_argument("--waves", action="store_true", help="open the demo's VCD in GTKWave")
+    ap.add_argument("--view", action="store_true", help="open the demo's VCD in GTKWave (make waves)")
     ap.add_argument("--name", default=NAME, help=argparse.SUPPRESS)  # build dir and VCD name (tests)
     args = ap.parse_args(argv)
     return args
@@ -386,8 +386,8 @@ def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
             if build_log.exists() else ""
         raise SystemExit(f"demo: build failed ({exc}); last lines of {build_log}:\n{tail}")
     t_build = time.monotonic() - t0
-    env = {"DEMO_PLAN": str(plan_file), "DEMO_RESULT": str(result_file),
-           "DEMO_PROGRESS": str(progress_file)}
+    env = {"ENC_DEMO_PLAN": str(plan_file), "ENC_DEMO_RESULT": str(result_file),
+           "ENC_DEMO_PROGRESS": str(progress_file)}
     if sim == "icarus":
         env["COCOTB_RESOLVE_X"] = "ZEROS"
     stop = threading.Event()
@@ -759,7 +759,7 @@ def open_waves() -> int:
 
 def main(argv=None) -> int:
     args = parse_args(argv)
-    if args.waves:
+    if args.view:
         return open_waves()
     try:
         opts = validate(args.rpm, args.temp_c, args.clk_hz, args.seed)

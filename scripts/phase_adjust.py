@@ -45,7 +45,7 @@ def main() -> int:
         t0 = time.monotonic()
         run("enc_phase_meter", "test_enc_phase_meter", name="phase_adjust",
             parameters={"WINDOW_LOG2": 13}, testcase="phase_adjust_sweep",
-            extra_env={"PHASE_ADJUST_OUT": str(out), "PHASE_ADJUST_READINGS": str(args.readings),
+            extra_env={"ENC_PHASE_ADJUST_OUT": str(out), "ENC_PHASE_ADJUST_READINGS": str(args.readings),
                        "COCOTB_LOG_LEVEL": "WARNING"})
         data = json.loads(out.read_text())
         print(f"phase_adjust: simulation done in {time.monotonic() - t0:.1f} s", flush=True)

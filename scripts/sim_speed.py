@@ -40,15 +40,15 @@ def main() -> int:
     ap.add_argument("--transitions", type=positive(int), default=20000)
     ap.add_argument("--state-clocks", type=positive(float), default=4.0,
                     help="shortest state in clocks (states last S..2S; default 4)")
-    ap.add_argument("--sims", nargs="+", choices=("icarus", "verilator"),
-                    default=["icarus", "verilator"])
+    ap.add_argument("--sim", nargs="+", choices=("icarus", "verilator"),
+                    default=["icarus", "verilator"], help="simulators to measure (default both)")
     args = ap.parse_args()
 
     import os
     from harness import run
 
     rows = []
-    for sim in args.sims:
+    for sim in args.sim:
         os.environ["SIM"] = sim
         print(f"sim_speed: {sim}: building and running {args.transitions} transitions ...", flush=True)
         with tempfile.TemporaryDirectory() as tmp:

@@ -89,7 +89,7 @@ def run_filter_len(fl: int, sim: str, quick: bool, seed: str | None, tmp: Path) 
 
     spec, out = tmp / f"job_F{fl}.json", tmp / f"out_F{fl}.json"
     spec.write_text(json.dumps(job_for(fl, quick)))
-    env = {"SWEEP_POINTS": str(spec), "SWEEP_OUT": str(out), "COCOTB_LOG_LEVEL": "WARNING"}
+    env = {"ENC_SWEEP_POINTS": str(spec), "ENC_SWEEP_OUT": str(out), "COCOTB_LOG_LEVEL": "WARNING"}
     if seed is not None:
         os.environ["SEED"] = seed
     try:

@@ -4,10 +4,10 @@ tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/d
 the records with the model and prints the table.
 
 Environment (set by scripts/demo.py):
-  DEMO_PLAN      JSON: clk_ps, events [[t_ns, a, b]...], seg {name: [t0_ns, t1_ns]}, meas_rst_ns,
+  ENC_DEMO_PLAN      JSON: clk_ps, events [[t_ns, a, b]...], seg {name: [t0_ns, t1_ns]}, meas_rst_ns,
                  hold_test_ns, hold_test_clocks, back_mid_ns
-  DEMO_RESULT    JSON written at the end (see ``result`` below)
-  DEMO_PROGRESS  a one-line file "<sim ns> <total ns> <segment>" rewritten as the run goes
+  ENC_DEMO_RESULT    JSON written at the end (see ``result`` below)
+  ENC_DEMO_PROGRESS  a one-line file "<sim ns> <total ns> <segment>" rewritten as the run goes
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ async def _hold_test(dut, t_ps: float, clocks: int, out: dict) -> None:
 
 @cocotb.test()
 async def demo(dut):
-    plan = json.loads(open(os.environ["DEMO_PLAN"]).read())
+    plan = json.loads(open(os.environ["ENC_DEMO_PLAN"]).read())
     clk_ps = int(plan["clk_ps"])
     events = [tuple(e) for e in plan["events"]]
     wf = Waveform(events=events, positions=[0] * len(events))
@@ -146,8 +146,8 @@ async def demo(dut):
                  _record_rises(dut.x1_dn, x1_dn), _record_rises(dut.x4_pulse, x4_pulses),
                  _record_pm(dut, pm), _record_ch(dut, ch)):
         cocotb.start_soon(coro)
-    if os.environ.get("DEMO_PROGRESS"):
-        cocotb.start_soon(_progress(os.environ["DEMO_PROGRESS"], t0, total_ns, seg))
+    if os.environ.get("ENC_DEMO_PROGRESS"):
+        cocotb.start_soon(_progress(os.environ["ENC_DEMO_PROGRESS"], t0, total_ns, seg))
     cocotb.start_soon(_pulse(dut, t0 + plan["meas_rst_ns"] * 1000, "meas_rst", clk_ps))
     hold_test: dict = {}
     cocotb.start_soon(_hold_test(dut, t0 + plan["hold_test_ns"] * 1000, plan["hold_test_clocks"],
@@ -187,5 +187,5 @@ async def demo(dut):
                    "x1_net": de["x1_count"] - ds["x1_count"]},
         "snaps": snaps,
     }
-    with open(os.environ["DEMO_RESULT"], "w") as f:
+    with open(os.environ["ENC_DEMO_RESULT"], "w") as f:
         json.dump(result, f)

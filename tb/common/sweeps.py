@@ -286,11 +286,11 @@ async def boundary_search(dut, base: dict, rng: random.Random, lo: float = 0.98,
 
 @cocotb.test()
 async def sweep_points(dut):
-    """scripts/sweep.py: run the job in $SWEEP_POINTS (a JSON file: {"points": [point, ...],
+    """scripts/sweep.py: run the job in $ENC_SWEEP_POINTS (a JSON file: {"points": [point, ...],
     "boundary": [point, ...]}; a boundary entry is a unit to walk up to its count limit) and
-    write the results to $SWEEP_OUT. Prints a progress line per point to stdout."""
+    write the results to $ENC_SWEEP_OUT. Prints a progress line per point to stdout."""
     rng = await start(dut)
-    with open(os.environ["SWEEP_POINTS"]) as f:
+    with open(os.environ["ENC_SWEEP_POINTS"]) as f:
         spec = json.load(f)
     fl = filter_len(dut)
     out = {"filter_len": fl, "points": [], "boundaries": []}
@@ -317,5 +317,5 @@ async def sweep_points(dut):
         print(f"sweep F={fl} {where[0]} {b['tag']}: limit {b['f_limit_hz']:.0f} Hz, "
               f"highest exact {b['measured_hz']:.0f} Hz (ratio {b['ratio']:.4f}), "
               f"{len(b['results'])} points", flush=True)
-    with open(os.environ["SWEEP_OUT"], "w") as f:
+    with open(os.environ["ENC_SWEEP_OUT"], "w") as f:
         json.dump(out, f, indent=1, default=float)

@@ -238,7 +238,7 @@ async def random_units(dut):
     await start_clock(dut)
     w = 2 ** window_log2(dut)
     max_cpc = w / 64.0
-    for k in range(int(os.environ.get("PHASE_UNITS", "8"))):
+    for k in range(int(os.environ.get("ENC_PHASE_UNITS", "8"))):
         cpc = async_cpc(rng, 100.0, min(max_cpc, 400.0))
         forward = rng.random() < 0.5
         ch = random_channels(rng)
@@ -382,11 +382,11 @@ async def commensurate_speed(dut):
 
 @cocotb.test()
 async def frequency_case(dut):
-    """One encoder speed chosen by the pytest entry (PHASE_CPC clocks/cycle): phases both ways."""
+    """One encoder speed chosen by the pytest entry (ENC_PHASE_CPC clocks/cycle): phases both ways."""
     rng = random.Random(log_seed(dut))
     await start_clock(dut)
-    cpc0 = float(os.environ["PHASE_CPC"])
-    cases = ((True, 45.0), (False, 135.0), (True, 92.0))[:int(os.environ.get("PHASE_CASES", "3"))]
+    cpc0 = float(os.environ["ENC_PHASE_CPC"])
+    cases = ((True, 45.0), (False, 135.0), (True, 92.0))[:int(os.environ.get("ENC_PHASE_CASES", "3"))]
     for forward, phase in cases:
         cpc = async_cpc(rng, cpc0, cpc0 * 1.01)
         ch = Channels(rise_phase=phase, pulse_err_a=rng.uniform(-10, 10), pulse_err_b=rng.uniform(-10, 10))
@@ -433,14 +433,14 @@ def adjust_waveform(cpc: float, phase_at, cycles: int, forward: bool, pulse_err=
 async def phase_adjust_sweep(dut):
     """scripts/phase_adjust.py: the technician turns the encoder body so that the phase moves
     slowly from 60 to 120 e-degrees (between the pulse centres) while the shaft runs forward, then runs the shaft in reverse
-    at the 90 degree setting. Writes the readings and the true phases to $PHASE_ADJUST_OUT."""
+    at the 90 degree setting. Writes the readings and the true phases to $ENC_PHASE_ADJUST_OUT."""
     import json
 
     await start_clock(dut)
     w = 2 ** window_log2(dut)
     cpc = 109.618034
     per_window = w / cpc
-    n_fwd = int(float(os.environ.get("PHASE_ADJUST_READINGS", "25")) * (per_window + 1.5))
+    n_fwd = int(float(os.environ.get("ENC_PHASE_ADJUST_READINGS", "25")) * (per_window + 1.5))
     # rise phase such that the phase between pulse centres (what the meter reads) runs 60 -> 120
     phase_fwd = lambda k: 65.0 + 60.0 * k / n_fwd  # noqa: E731
     wf = adjust_waveform(cpc, phase_fwd, n_fwd, True)
@@ -465,7 +465,7 @@ async def phase_adjust_sweep(dut):
             true = 95.0 + (-4.0 - 6.0) / 2.0
         rows.append({"t_ms": t_ns / 1e6, "phase_err": perr, "true_err": true - 90.0,
                      "a_leads": a_l, "b_leads": b_l, "forward": t1 <= t_end})
-    with open(os.environ["PHASE_ADJUST_OUT"], "w") as f:
+    with open(os.environ["ENC_PHASE_ADJUST_OUT"], "w") as f:
         json.dump({"window_log2": window_log2(dut), "clocks_per_cycle": cpc, "clk_ns": CLK_PS / 1000,
                    "readings": rows}, f, indent=1)
 
@@ -492,7 +492,7 @@ def test_enc_phase_meter_speed(log2, cpc, cases):
     slow for Icarus), each held to the 0.25 degree bound."""
     run("enc_phase_meter", "test_enc_phase_meter", name=f"enc_phase_meter_w{log2}",
         parameters={"WINDOW_LOG2": log2}, testcase="frequency_case",
-        extra_env={"PHASE_CPC": str(cpc), "PHASE_CASES": str(cases)})
+        extra_env={"ENC_PHASE_CPC": str(cpc), "ENC_PHASE_CASES": str(cases)})
 
 
 @pytest.mark.parametrize("value", [7, 25])
