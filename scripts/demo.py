@@ -10,7 +10,7 @@ What it does:
      dither about it (the note's "stationary shaft oscillating slightly about a transition").
   3. Simulates tb/hdl/demo_top.v (conditioner, 1X Figure 14, 2X Figure 15, 4X look-up table,
      Figure 17 BCD up/down buffer, Figure 11 phase meter, characterizer) with cocotb
-     (tb/demo_bench.py) at ``--clk-hz``, printing a progress line: on Icarus for short runs
+     (scripts/benches/demo_bench.py) at ``--clk-hz``, printing a progress line: on Icarus for short runs
      (it starts at once), on Verilator for long ones (faster once its C++ build is done).
   4. Prints one table: the true position against every count, the phase meter against the model's
      true phase over the same cycles, the characterizer against the model, the narrowest state

@@ -8,7 +8,7 @@ electrical degrees between the pulse centres (pulse-width errors +6 / -4 e-degre
 edges are 5 degrees further apart than that); then the shaft is run in reverse at the 90 degree setting, the note's advice to
 "turn the shaft in both directions". The averaging phase meter (rtl/enc_phase_meter.v,
 WINDOW_LOG2 = 13) runs in a cocotb simulation (Icarus by default; SIM=verilator for Verilator),
-through tb/harness.run and the `phase_adjust_sweep` test in tb/test_enc_phase_meter.py.
+through tb/common/harness.run and the `phase_adjust_sweep` test in tb/enc_phase_meter/test_enc_phase_meter.py.
 
 Prints each reading with the two LEDs as a table, and saves sim/figures/phase_adjust.png (meter
 reading vs true phase). Usage: scripts/phase_adjust.py [--readings N] [--sim icarus|verilator]

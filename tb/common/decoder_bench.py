@@ -3,7 +3,7 @@
 enc_x4_decoder (look-up-table 4X), enc_x2_xor (Figure 15), enc_x1_hysteresis (Figure 14).
 
 Stimulus is a sequence of (a, b) samples, one per clock, as enc_conditioner delivers them. Every
-test compares every output on every clock with the model in tb/models.py; the 1X tests also check
+test compares every output on every clock with the model in tb/common/models.py; the 1X tests also check
 the contract's hysteresis bound |4n - p| <= 4 directly, which is what the naive counter fails.
 """
 

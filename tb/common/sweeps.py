@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Shared logic of the counting-circuit sweeps (issue 4): tb/test_sweeps.py and scripts/sweep.py.
+"""Shared logic of the counting-circuit sweeps (issue 4): tb/sweeps/test_sweeps.py and scripts/sweep.py.
 
 A sweep *point* is one constant-speed run of one modelled HEDS-5000 unit (the hedsmodel package, python/) played
 into tb/hdl/enc_quad_probe.v (enc_conditioner -> enc_x4_decoder, enc_x2_xor, enc_x1_hysteresis,
@@ -17,7 +17,7 @@ the clock, waits FILTER_LEN + 6 clocks and reads the accumulators. The truth com
 waveform itself (``Waveform.positions``: the states the unit's outputs actually show), the timing
 from :func:`hedsmodel.measure` and from the event list:
 
-- ``exact``: pos4 == true 4X change, pos2 == true 2X change ((p + 1) // 2, tb/models.py),
+- ``exact``: pos4 == true 4X change, pos2 == true 2X change ((p + 1) // 2, tb/common/models.py),
   |4 pos1 - p| < 8 (the contract's 1X hysteresis bound), and no error / glitch flag at all;
 - ``silent4`` / ``silent2`` / ``silent1``: a count is wrong (pos1: out of its bound) and its path
   raised no flag (n_err4 / n_err2 / n_err1 + n_glitch = 0): the one outcome the contract never

@@ -195,7 +195,7 @@ async def reversal_abandons_window(dut):
 
 @cocotb.test()
 async def hedsmodel_units(dut):
-    """Units drawn from the note's tables by tb/hedsmodel, 600 rpm, clk 1 MHz (~200 clocks/cycle)."""
+    """Units drawn from the note's tables by the hedsmodel package, 600 rpm, clk 1 MHz (~200 clocks/cycle)."""
     from hedsmodel import EncoderUnit, Profile, measure
 
     seed = log_seed(dut)

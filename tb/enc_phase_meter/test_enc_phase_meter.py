@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_phase_meter (Figure 11, the averaging phase meter) against the continuous waveform.
 
-The stimulus comes from tb/phase_models.py: waveforms computed from the shaft angle, edges at
+The stimulus comes from tb/common/phase_models.py: waveforms computed from the shaft angle, edges at
 real-valued times (never on the clock grid), optional pulse-width error, phase, timing jitter,
 stops and reversals. The expected reading is computed from the waveform, not from the RTL:
   - steady units: the true phase (between pulse centres = mean of rising- and falling-edge

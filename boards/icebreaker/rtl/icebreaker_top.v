@@ -17,7 +17,7 @@
 //       wrong), G = glitch rejected by the conditioner, I = index pulse seen
 // Position and phase are sampled at the start of the line; B is frozen by `hold` at that moment.
 //
-// Pins (constraints/icebreaker.pcf): clk 35 (12 MHz oscillator), btn_n 10 (user button, reset
+// Pins (boards/icebreaker/icebreaker.pcf): clk 35 (12 MHz oscillator), btn_n 10 (user button, reset
 // while pressed), tx 9 (FTDI channel B RX, i.e. the board's UART output), led_r_n 11 and
 // led_g_n 37 (active low), PMOD1A: enc_a = P1A1 (pin 4), enc_b = P1A2 (pin 2),
 // enc_i = P1A3 (pin 47); encoder ground on PMOD1A pin 5/11. The HEDS-5000 needs 5 V and has
