@@ -251,7 +251,7 @@ def random_phase(tb, rng):
 
 
 def constant_jobs(args, units, rpms, rng):
-    dur_min, dur_max = (0.05, 2.0) if args.quick else (0.25, 30.0)
+    dur_min, dur_max = (0.05, 2.0) if args.quick else (0.25, 60.0)
     jobs = []
     for rpm in rpms:
         dur = min(max(60.0 / rpm, dur_min), dur_max)    # one revolution when affordable
@@ -430,6 +430,8 @@ SIM_UNITS = 2          # the ideal unit and the first typical one
 READ_REGS = ("SNAP_COUNT_LO", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA",
              "PERIOD", "PERIOD_CTRL", "STATUS")   # what scripts/benches/velocity_bench_sim.py reads
 SIM_T0_MS = 0.3        # first read, ms after the waveform starts
+SIM_STOP_RPM = 300.0   # the simulated stop: 3 ms at this speed, then 6 ms standing
+SIM_STALL_S = 2e-3     # ... with this stall timeout (STALL_TIMEOUT and the estimators)
 
 
 def sim_cases(args, units, rpms, rng):
@@ -447,12 +449,24 @@ def sim_cases(args, units, rpms, rng):
         n = max(args.sim_reads, int(math.ceil(3 * cycle_ms)) + 3)
         dur_s = (SIM_T0_MS + n - 0.5) * 1e-3
         for name, unit in units[:SIM_UNITS]:
-            wf = unit.waveform(build_profile([("constant", rpm * DETUNE, dur_s)]))
+            spec = [("constant", rpm * DETUNE, dur_s)]
+            wf = unit.waveform(build_profile(spec))
             for edge in ("any", "a_rising"):
                 t0 = SIM_T0_MS + float(rng.uniform(0, 0.2))
-                cases.append({"id": f"{name} {rpm:g} rpm {edge}", "unit": name, "rpm": rpm,
-                              "edge_name": edge, "wf": wf, "profile_dur_s": dur_s,
+                cases.append({"id": f"{name} {rpm:g} rpm {edge}", "kind": "constant",
+                              "unit": name, "rpm": rpm, "edge_name": edge, "wf": wf,
+                              "profile": spec, "stall_s": args.stall_ms * 1e-3,
                               "reads_ns": [1e6 * (t0 + k) for k in range(n)]})
+    # a stop, with a short stall timeout (a 200 ms one would take 20 M clocks to simulate)
+    name, unit = units[min(1, len(units) - 1)]
+    spec = [("constant", SIM_STOP_RPM * DETUNE, 3e-3), ("stop", 6e-3)]
+    wf = unit.waveform(build_profile(spec))
+    for edge in ("any", "a_rising"):
+        t0 = SIM_T0_MS + float(rng.uniform(0, 0.2))
+        cases.append({"id": f"{name} stop after {SIM_STOP_RPM:g} rpm {edge}", "kind": "stop",
+                      "unit": name, "rpm": SIM_STOP_RPM, "edge_name": edge, "wf": wf,
+                      "profile": spec, "stall_s": SIM_STALL_S,
+                      "reads_ns": [1e6 * (t0 + k) for k in range(9)]})
     return cases
 
 
@@ -479,7 +493,6 @@ def run_sim(args, units, rpms) -> dict:
     cases = sim_cases(args, units, rpms, rng)
     tb = timebase(args)
     clk_ps = int(round(1e6 / args.clk_mhz))
-    stall_ticks = int(round(args.stall_ms * 1e-3 / tb.tick_s))
     groups = [cases[i::args.jobs] for i in range(min(args.jobs, len(cases)))]
     tmp = Path(tempfile.mkdtemp(prefix="velocity_sim_"))
     plans = []
@@ -487,7 +500,8 @@ def run_sim(args, units, rpms) -> dict:
         plan = {"clk_ps": clk_ps, "regs": regs, "bits": bits, "cases": [
             {"id": c["id"], "events": [list(e) for e in c["wf"].events],
              "reads_ns": c["reads_ns"], "edge": a_rising if c["edge_name"] == "a_rising" else 0,
-             "prescale": args.prescale, "period_n": 1, "stall_ticks": stall_ticks}
+             "prescale": args.prescale, "period_n": 1,
+             "stall_ticks": int(round(c["stall_s"] / tb.tick_s))}
             for c in grp]}
         path = tmp / f"plan_{gi}.json"
         path.write_text(json.dumps(plan))
@@ -559,7 +573,7 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
     import numpy as np
 
     from hedsmodel.velocity import (EstimatorConfig, Snapshot, SnapTrace, counts_per_edge,
-                                    edge_table, estimate, exact_twin)
+                                    edge_table, estimate, exact_twin, true_rpm)
 
     et = edge_table(case["wf"])
     edge = case["edge_name"]
@@ -617,7 +631,7 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
             stalled=(r["STATUS"] >> bits["STATUS.STALLED"]) & 1))
     trace = SnapTrace(snaps, t_read, t_latch, last_edge, p_from, p_to)
     cpe = counts_per_edge(edge)
-    stall_s = args.stall_ms * 1e-3
+    stall_s = case["stall_s"]
     hw = estimate(snaps, EstimatorConfig(tick_s=tick, ts_w=32, counts_per_edge=cpe,
                                          stall_ticks=int(round(stall_s / tick))))
     fl = estimate(exact_twin(trace, et, med * tick), EstimatorConfig(
@@ -645,10 +659,28 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
         checked["delta"] += 1
         want = int((et.pos[n_at[i] - 1] if n_at[i] else 0) - (et.pos[n_at[i - 1] - 1] if n_at[i - 1] else 0))
         bad_delta += snaps[i].delta != want
+    true_t = np.abs(true_rpm(build_profile(case["profile"]), t_latch - med * tick))
     true = case["rpm"] * DETUNE
     res = {"unit": case["unit"], "rpm": case["rpm"], "edge": edge, "reads": len(reads),
+           "kind": case["kind"],
            "unmatched": unmatched, "bad_edge_delta": bad_edge_delta, "bad_period": bad_period,
            "bad_delta": bad_delta, "checked": checked, "latency_ticks": med, "methods": {}}
+    if case["kind"] == "stop":
+        t_stop = max(pc.tb for pc in build_profile(case["profile"]).pieces())
+        stalled = np.array([sn.stalled for sn in snaps], bool)
+        last_step = float(et.t_s[-1]) if et.t_s.size else 0.0
+        res["stop"] = {"stall_s": stall_s, "t_stop_s": t_stop, "last_step_s": last_step,
+                       "stalled_at_s": float(t_latch[stalled][0]) if stalled.any() else math.nan,
+                       "stalled_before_timeout": bool(np.any(stalled & (t_latch < last_step + stall_s - 2 * tick)))}
+        for meth in ("M", "T", "MT"):
+            if (meth, edge) not in VARIANTS:
+                continue
+            h = hw[meth]
+            nz = np.flatnonzero(h != 0)
+            t_zero = float(t_latch[nz[-1] + 1]) if nz.size and nz[-1] + 1 < h.size else math.nan
+            res["methods"][meth] = {"t_zero_after_stop_s": t_zero - t_stop,
+                                    "moving_zeros": int(np.sum((h == 0) & (true_t > 0) & (np.arange(h.size) >= 2)))}
+        return res
     for meth in ("M", "T", "MT"):
         if (meth, edge) not in VARIANTS:
             continue
@@ -685,6 +717,8 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
           "| M/T error max (%) | zeros M/T | checks failed (edge Δ / period / Δ of checked) "
           "| unmatched |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|"]
     points = []
+    stops = [r for r in results if r["kind"] == "stop"]
+    results = [r for r in results if r["kind"] != "stop"]
     for r in results:
         m = r["methods"]
         mt, t = m.get("MT", {}), m.get("T", {})
@@ -699,6 +733,24 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
         if r["edge"] == "a_rising" and mt.get("n"):
             points.append({"rpm": r["rpm"], "unit": r["unit"], "added_max": mt["added_max"]})
     L.append("")
+    if stops:
+        L += [f"**Stop** ({stops[0]['unit']}): {SIM_STOP_RPM:g} rpm for 3 ms, then standing, with "
+              f"STALL_TIMEOUT and the estimators' timeout at {SIM_STALL_S * 1e3:g} ms. Time from "
+              "the stop to the reading that stays 0, and when STATUS.STALLED was first seen "
+              "(ms after the last count step; reads are 1 ms apart).", "",
+              "| edges | M/T → 0 (ms after stop) | T → 0 | M → 0 | STALLED seen (ms after last step) "
+              "| STALLED before the timeout | zeros while turning (M/T) |",
+              "|---|---:|---:|---:|---:|---|---:|"]
+        for r in stops:
+            m, st = r["methods"], r["stop"]
+            def f(k, m=m):
+                v = m.get(k, {}).get("t_zero_after_stop_s", math.nan)
+                return "—" if math.isnan(v) else f"{1e3 * v:.2f}"
+            L.append(f"| {'A↑' if r['edge'] == 'a_rising' else 'any'} | {f('MT')} | {f('T')} | "
+                     f"{f('M')} | {1e3 * (st['stalled_at_s'] - st['last_step_s']):.2f} | "
+                     f"{'yes (wrong)' if st['stalled_before_timeout'] else 'no'} | "
+                     f"{m.get('MT', {}).get('moving_zeros', 0)} |")
+        L.append("")
     goals_ = []
     band = [r for r in results if r["edge"] == "a_rising" and GOAL_BAND[0] <= r["rpm"] <= GOAL_BAND[1]]
     for label, sel, lim in (("non-ideal", [r for r in band if r["unit"] != "ideal"], GOAL_ADDED_TYP),
@@ -718,6 +770,17 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
     nchk = sum(sum(r["checked"].values()) for r in results)
     goals_.append(f"{'MET' if nbad == 0 else 'MISSED'} (through the RTL): {nbad} inconsistencies "
                   f"between the latched registers and the model in {nchk} checks.")
+    for r in stops:
+        tz = r["methods"].get("MT", {}).get("t_zero_after_stop_s", math.nan)
+        ok = tz <= SIM_STALL_S + 1.5 / READ_HZ and not r["stop"]["stalled_before_timeout"] \
+            and not math.isnan(r["stop"]["stalled_at_s"])
+        goals_.append(f"{'MET' if ok else 'MISSED'} (through the RTL): after a stop, M/T "
+                      f"{'A↑' if r['edge'] == 'a_rising' else 'any edge'} reads 0 "
+                      f"{1e3 * tz:.2f} ms after the stop (timeout {SIM_STALL_S * 1e3:g} ms, reads "
+                      f"every 1 ms); STATUS.STALLED "
+                      + ("never seen" if math.isnan(r["stop"]["stalled_at_s"]) else
+                         f"seen {1e3 * (r['stop']['stalled_at_s'] - r['stop']['last_step_s']):.2f} ms "
+                         "after the last step") + ".")
     return {"lines": L, "goals": goals_, "points": points, "results": results, "wall_s": wall}
 
 
@@ -760,7 +823,7 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
           f"{', --quick' if args.quick else ''}; {wall_s / 60:.1f} min on {args.jobs} "
           f"job(s). Relative errors in % of the true shaft speed: *rms* and *max* over the "
           f"readings of a run (one revolution per speed, at most "
-          f"{2 if args.quick else 30} s, from the third read and one read after the third A-rising edge); "
+          f"{2 if args.quick else 60} s, from the third read and one read after the third A-rising edge); "
           "*floor* = the same estimator on the model's exact edge times (the encoder's own "
           "error); *added* = max |latched − floor| / true speed (what the timebase adds); "
           "*zeros* = readings of exactly 0 while turning.", ""]

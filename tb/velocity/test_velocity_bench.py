@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from hedsmodel import EncoderUnit
-from hedsmodel.velocity import Timebase, snapshot_trace
+from hedsmodel.velocity import Timebase, edge_table, snapshot_trace
 
 TOP = Path(__file__).resolve().parents[2]
 SCRIPT = TOP / "scripts" / "velocity_bench.py"
@@ -61,15 +61,18 @@ def fake_raw(case, tb: Timebase, start_s: float, bits: dict):
     reads = np.array(case["reads_ns"]) * 1e-9
     tr = snapshot_trace(case["wf"], 1000.0, case["edge_name"], 1, tbx, reads[0], reads[-1] + 1e-9)
     cal_s = start_s - 30 * clk
+    steps = edge_table(case["wf"]).t_s + tb.latency_clocks * clk
     out = []
     for s, t in zip(tr.snaps, tr.t_read_s):
+        before = steps[steps <= t]
+        stalled = int(before.size > 0 and t - before[-1] >= case["stall_s"])
         out.append({"t_ack_ps": (start_s + t) * 1e12, "SNAP_COUNT_LO": s.count,
                     "SNAP_TIME": s.time, "SNAP_EDGE_TIME": s.edge_time,
                     "SNAP_DELTA": s.delta & 0xFFFFFFFF, "SNAP_EDGE_DELTA": s.edge_delta & 0xFFFFFFFF,
                     "PERIOD": s.period,
                     "PERIOD_CTRL": (s.period_ovf << bits["PERIOD_CTRL.OVERFLOW"])
                     | (s.period_dir_change << bits["PERIOD_CTRL.DIR_CHANGE"]),
-                    "STATUS": 0})
+                    "STATUS": stalled << bits["STATUS.STALLED"]})
     return {"t_start_ps": start_s * 1e12, "t_cal0_ps": cal_s * 1e12, "t_cal1_ps": cal_s * 1e12,
             "tb_cal": (k0 - 30) // (tb.prescale + 1), "reads": out}
 
@@ -83,16 +86,28 @@ def test_sim_analysis_on_ideal_registers(bench):
     rng = np.random.default_rng(7)
     cases = bench.sim_cases(args, units, [30.0, 394.0, 12000.0], rng)
     tb = bench.timebase(args)
+    results = []
     for c in cases:
         raw = fake_raw(c, tb, start_s=0.0123, bits=bits)
         r = bench.analyse_case(c, raw, args, tb, bits)
+        results.append(r)
         print(c["id"], r["latency_ticks"], r["checked"], {k: v.get("added_max")
                                                          for k, v in r["methods"].items()})
         assert r["unmatched"] == 0 and r["bad_edge_delta"] == 0 and r["bad_period"] == 0 \
             and r["bad_delta"] == 0, r
         assert r["checked"]["edge_delta"] > 0 and r["checked"]["delta"] > 0
         assert abs(r["latency_ticks"] - tb.latency_clocks) <= 1.5
+        if c["kind"] == "stop":
+            st, mt = r["stop"], r["methods"]["MT"]
+            assert not st["stalled_before_timeout"]
+            assert 0 < st["stalled_at_s"] - st["last_step_s"] <= c["stall_s"] + 1.1e-3
+            assert mt["t_zero_after_stop_s"] <= c["stall_s"] + 1.1e-3 and mt["moving_zeros"] == 0
+            continue
         mt = r["methods"]["MT"]
         assert mt["n"] >= 1, r
         assert mt["added_max"] < 2e-4, r
         assert mt["zeros"] == 0
+    rep = bench.sim_report(args, units, results, 1.0, "ideal registers", {})
+    print("\n".join(rep["lines"] + rep["goals"]))
+    assert rep["goals"] and all(g.startswith("MET") for g in rep["goals"]), rep["goals"]
+    assert len(rep["points"]) == 6
