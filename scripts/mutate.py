@@ -37,6 +37,7 @@ Options:
   --only M[,M]     just these modules
   --list           print the module/corner/test mapping and exit
   --keep           keep the build directories of killed mutants too
+  --rev REV        the RTL of a git revision (e.g. HEAD) instead of the working tree
   --mutation CMD   run given mutations instead (with one --only module): how the deterministic
                    tests were shown to kill the mutants of issue 14, see doc/mutation.md
 """
@@ -150,6 +151,37 @@ def run_yosys(script: str, log: Path, timeout: float = 600) -> subprocess.Comple
     return proc
 
 
+SNAPSHOT = BUILD_REL / "rtl"  # set by main(): the RTL this run reads (a copy; rtl/ may change)
+
+
+def core_rtl_files() -> list[str]:
+    sys.path.insert(0, str(TOP / "tb" / "common"))
+    from core_file import rtl_files
+    return rtl_files()
+
+
+def snap(f: str) -> str:
+    """The run's copy of rtl file `f` (relative to TOP, as YoWASP needs)."""
+    return str(SNAPSHOT / f)
+
+
+def take_snapshot(root: Path, rev: str | None) -> None:
+    """Copy the core's RTL (working tree, or `rev` from git) under the run's directory: every run
+    of the tests and every Yosys step read that copy, so edits to rtl/ during a run (or a file
+    someone is halfway through) cannot mix into it."""
+    global SNAPSHOT
+    SNAPSHOT = root.relative_to(TOP) / "src"
+    for f in core_rtl_files():
+        dst = TOP / SNAPSHOT / f
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if rev:
+            text = subprocess.run(["git", "show", f"{rev}:{f}"], cwd=TOP, capture_output=True,
+                                  text=True, check=True).stdout
+        else:
+            text = (TOP / f).read_text()
+        dst.write_text(text)
+
+
 def module_defaults(path: Path) -> dict[str, str]:
     """The parameters a module declares, with their default values (as written)."""
     text = re.sub(r"//.*", "", path.read_text())
@@ -215,14 +247,15 @@ class Mutant:
 
     def describe(self) -> str:
         o = self.opts
-        what = f"{o.get('mode')} {o.get('cell')}.{o.get('port')}[{o.get('portbit')}]"
+        cell = o.get("cell", "").replace(f"{SNAPSHOT}/", "")
+        what = f"{o.get('mode')} {cell}.{o.get('port')}[{o.get('portbit')}]"
         if "ctrlbit" in o:
             what += f" ctrl[{o['ctrlbit']}]"
         if "wire" in o:
             what += f" ({o['wire']}[{o.get('wirebit')}])"
-        srcs = o.get("src", [])
+        srcs = sorted(o.get("src", []), key=lambda x: len(src_text(x)))  # innermost first
         if srcs:
-            loc = srcs[0].split("-")[0].rsplit(".", 1)[0]
+            loc = srcs[0].split("-")[0].rsplit(".", 1)[0].replace(f"{SNAPSHOT}/", "")
             what += f" at {loc} `{src_text(srcs[0])[:60]}`"
         return what
 
@@ -274,24 +307,27 @@ def corner_dir(root: Path, c: Corner) -> Path:
 
 
 def chparams(c: Corner) -> str:
-    defaults = module_defaults(TOP / c.file)
+    defaults = module_defaults(TOP / snap(c.file))
     params = {k: defaults[k] for k in defaults}
     params.update({k: str(v) for k, v in c.params.items()})
     return " ".join(f"-chparam {k} {v}" for k, v in params.items())
 
 
 def param_decls(c: Corner) -> str:
-    defaults = module_defaults(TOP / c.file)
+    defaults = module_defaults(TOP / snap(c.file))
     params = {k: defaults[k] for k in defaults}
     params.update({k: str(v) for k, v in c.params.items()})
     return "".join(f"  parameter integer {k} = {v};\n" for k, v in params.items())
 
 
 def elaborate_script(c: Corner) -> str:
-    lib = "".join(f"read_verilog -lib {d}\n" for d in c.deps)
-    return (f"{lib}read_verilog {c.file}\n"
+    lib = "".join(f"read_verilog -lib {snap(d)}\n" for d in c.deps)
+    return (f"{lib}read_verilog {snap(c.file)}\n"
             f"hierarchy -top {c.module} {chparams(c)}\n"
-            f"proc\nopt_clean\nrename -top {c.module}\n")
+            f"proc\nmemory -nomap\nopt_clean\nrename -top {c.module}\n"
+            # registers without a reset start at 0 (as in the iCE40): a netlist's muxes spread
+            # an X that the RTL's `if` hides, so the round trip would not pass the tests otherwise
+            f"setundef -zero -init {c.module}\n")
 
 
 def add_params(verilog: str, c: Corner) -> str:
@@ -314,6 +350,7 @@ def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None =
     if given is None:
         script += f"mutate -list {n} -seed {seed} -o {rel}/list.ys {c.module}\n"
     else:
+        given = [g.replace("$rtl/", f"${SNAPSHOT}/rtl/") for g in given]  # cells named by rtl path
         (d / "list.ys").write_text("".join(
             (g if " -module " in g else g.replace("mutate ", f"mutate -module {c.module} ", 1)) + "\n"
             for g in given))
@@ -346,7 +383,10 @@ def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: fl
     """pytest on the corner's tests with `verilog` in place of the module's rtl file. Returns
     (passed, timed_out, seconds, first failed test id)."""
     env = dict(os.environ)
-    env.update(ENC_RTL_OVERRIDE=f"{c.file}={verilog}", ENC_BUILD_ROOT=str(build), SIM="icarus",
+    override = {f: TOP / snap(f) for f in core_rtl_files()}
+    override[c.file] = verilog
+    env.update(ENC_RTL_OVERRIDE=",".join(f"{k}={v}" for k, v in override.items()),
+               ENC_BUILD_ROOT=str(build), SIM="icarus",
                SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1")
     env.pop("WAVES", None)
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
@@ -379,7 +419,7 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
     c = m.corner
     d = corner_dir(root, c)
     rel = d.relative_to(TOP)
-    deps = "".join(f"read_verilog {x}\n" for x in c.deps)
+    deps = "".join(f"read_verilog {snap(x)}\n" for x in c.deps)
 
     def side(name: str, mutate: str) -> str:
         return (f"read_rtlil {rel}/orig.il\n{mutate}{deps}hierarchy -top {c.module}\n"
@@ -431,6 +471,8 @@ def main() -> int:
     ap.add_argument("--only", default="", help="comma-separated modules")
     ap.add_argument("--list", action="store_true")
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--rev", default=None, help="mutate the RTL of this git revision (default: the "
+                    "working tree)")
     ap.add_argument("--mutation", action="append", default=[], metavar="CMD",
                     help="run this `mutate -mode ... -cell ...` command (repeatable) instead of "
                     "mutate -list, on the one --only module at each of its corners; cell names "
@@ -462,6 +504,7 @@ def main() -> int:
     if root.exists():
         shutil.rmtree(root)
     root.mkdir(parents=True)
+    take_snapshot(root, args.rev)
     reviewed = load_reviewed()
     lock = threading.Lock()
 
