@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: Apache-2.0
+// enc_conditioner_rt -- enc_conditioner with the filter length as a run-time input.
+//
+// Same circuit, same timing and same outputs as enc_conditioner at the same length: per channel
+//   a_in -> two flip-flops (synchronizer) -> filter_len-sample filter -> a
+// The filter output takes a new level only after the synchronized input has shown that level on
+// filter_len consecutive clocks; a level that goes back sooner is rejected and `glitch` pulses
+// for one clock (never with filter_len = 1). An output changes filter_len + 1 clocks after the
+// rising edge that first samples the new level. `valid` rises filter_len + 2 clocks after rst
+// falls (hold a decoder behind this block in reset while it is low).
+// filter_len is clamped to 1 .. MAX_FILTER_LEN (0 acts as 1). It may change at any time: a
+// candidate level already seen on at least the new length of samples is accepted at the next
+// differing sample, so a change never loses or invents a level. enc_conditioner is this module
+// with filter_len tied to FILTER_LEN and MAX_FILTER_LEN = FILTER_LEN (then the run counter and
+// the settling chain are exactly as wide as the fixed-length circuit's).
+`default_nettype none
+
+module enc_conditioner_rt #(
+    parameter integer MAX_FILTER_LEN = 16  // largest filter_len used: 1 .. 16 (sizes the counters)
+) (
+    input  wire       clk,
+    input  wire       rst,         // synchronous, active high
+    input  wire [4:0] filter_len,  // samples a new level must persist: 1 .. MAX_FILTER_LEN
+    input  wire       a_in,        // channel A, asynchronous
+    input  wire       b_in,        // channel B, asynchronous
+    output wire       a,           // conditioned channel A, synchronous to clk
+    output wire       b,           // conditioned channel B, synchronous to clk
+    output wire       glitch,      // one-clock pulse per rejected level (either channel)
+    output wire       valid        // a and b reflect the inputs (filter_len + 2 clocks after rst)
+);
+
+  generate
+    if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len
+`ifdef __ICARUS__
+      enc_conditioner_rt__parameter_MAX_FILTER_LEN_must_be_1_to_16 u_stop ();
+`else
+      $error("enc_conditioner_rt: parameter MAX_FILTER_LEN must be in 1 .. 16");
+`endif
+    end
+  endgenerate
+
+  // Run-length counter: consecutive samples (so far) that differ from the accepted level.
+  localparam integer CW = (MAX_FILTER_LEN <= 2) ? 1 : (MAX_FILTER_LEN <= 4) ? 2 :
+                          (MAX_FILTER_LEN <= 8) ? 3 : 4;
+  localparam integer MAX_LAST_INT = MAX_FILTER_LEN - 1;
+  localparam [4:0] MAX_LAST5 = MAX_LAST_INT[4:0];
+
+  // last = clamp(filter_len, 1, MAX_FILTER_LEN) - 1: a differing sample seen with run >= last
+  // accepts.
+  wire [4:0] len_m1 = (filter_len == 5'd0) ? 5'd0 : filter_len - 5'd1;
+  wire [4:0] last5  = (len_m1 > MAX_LAST5) ? MAX_LAST5 : len_m1;
+  wire [CW-1:0] last = last5[CW-1:0];
+
+  // ---- synchronizer: two flip-flops per channel -----------------------------------------------
+  reg [1:0] meta_q;  // {b, a} first stage
+  reg [1:0] sync_q;  // {b, a} second stage
+
+  always @(posedge clk) begin
+    if (rst) begin
+      meta_q <= 2'b00;
+      sync_q <= 2'b00;
+    end else begin
+      meta_q <= {b_in, a_in};
+      sync_q <= meta_q;
+    end
+  end
+
+  // ---- filter: the same logic for each channel ------------------------------------------------
+  wire [1:0] level;   // {b, a} accepted levels
+  wire [1:0] reject;  // this clock a candidate level went back before it was accepted
+
+  genvar ch;
+  generate
+    for (ch = 0; ch < 2; ch = ch + 1) begin : g_filter
+      reg          level_q;
+      reg          level_d;
+      reg [CW-1:0] run_q;
+      reg [CW-1:0] run_d;
+      reg          reject_d;
+
+      always @(*) begin
+        level_d  = level_q;
+        run_d    = run_q;
+        reject_d = 1'b0;
+        if (sync_q[ch] != level_q) begin
+          if (run_q >= last) begin
+            level_d = sync_q[ch];  // filter_len-th consecutive sample of the new level: accept
+            run_d   = {CW{1'b0}};
+          end else begin
+            run_d = run_q + 1'b1;
+          end
+        end else if (run_q != {CW{1'b0}}) begin
+          run_d    = {CW{1'b0}};   // back to the accepted level too soon: reject
+          reject_d = 1'b1;
+        end
+      end
+
+      always @(posedge clk) begin
+        if (rst) begin
+          level_q <= 1'b0;
+          run_q   <= {CW{1'b0}};
+        end else begin
+          level_q <= level_d;
+          run_q   <= run_d;
+        end
+      end
+
+      assign level[ch]  = level_q;
+      assign reject[ch] = reject_d;
+    end
+  endgenerate
+
+  // ---- settling after reset: 2 synchronizer clocks + filter_len filter clocks ------------------
+  // A chain of flip-flops filling with ones after rst; valid is the stage filter_len + 1.
+  localparam integer SETTLE = MAX_FILTER_LEN + 2;
+  reg [SETTLE-1:0] settle_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      settle_q <= {SETTLE{1'b0}};
+    end else begin
+      settle_q <= {settle_q[SETTLE-2:0], 1'b1};
+    end
+  end
+
+  // valid = settle_q[last5 + 1] (a loop, so the index needs no width of its own)
+  wire [4:0] valid_tap = last5 + 5'd1;
+  reg        valid_d;
+  integer    i;
+
+  always @(*) begin
+    valid_d = 1'b0;
+    for (i = 0; i < SETTLE; i = i + 1) begin
+      if (valid_tap == i[4:0]) valid_d = settle_q[i];
+    end
+  end
+
+  reg glitch_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      glitch_q <= 1'b0;
+    end else begin
+      glitch_q <= |reject;
+    end
+  end
+
+  assign a      = level[0];
+  assign b      = level[1];
+  assign glitch = glitch_q;
+  assign valid  = valid_d;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,181 @@
+// SPDX-License-Identifier: Apache-2.0
+// enc_qei_axil -- enc_qei with an AXI4-Lite slave port (32-bit data, 8-bit byte address).
+//
+// A thin adapter: one skid register per address/data channel (AW, W, AR), one request to
+// enc_qei at a time, and the response held on B or R until the master takes it. A write is
+// issued once both its address and data have arrived; reads and writes alternate when both
+// wait. An unmapped offset answers SLVERR (reads 0, writes nothing); every access completes
+// whatever the master's ready/valid timing. awprot/arprot are ignored. All the peripheral's
+// behaviour is in enc_qei.
+`default_nettype none
+
+module enc_qei_axil #(
+    parameter integer COUNT_W = 32,  // counter width: 8 .. 64
+    parameter integer TS_W    = 32   // timebase / timestamp width: 16 .. 32
+) (
+    input  wire        clk,
+    input  wire        rst,            // synchronous, active high
+    // AXI4-Lite slave
+    input  wire [7:0]  s_axil_awaddr,  // byte address (bits 1:0 ignored)
+    // verilator lint_off UNUSEDSIGNAL
+    input  wire [2:0]  s_axil_awprot,  // ignored
+    // verilator lint_on UNUSEDSIGNAL
+    input  wire        s_axil_awvalid,
+    output wire        s_axil_awready,
+    input  wire [31:0] s_axil_wdata,
+    input  wire [3:0]  s_axil_wstrb,
+    input  wire        s_axil_wvalid,
+    output wire        s_axil_wready,
+    output wire [1:0]  s_axil_bresp,
+    output wire        s_axil_bvalid,
+    input  wire        s_axil_bready,
+    input  wire [7:0]  s_axil_araddr,  // byte address (bits 1:0 ignored)
+    // verilator lint_off UNUSEDSIGNAL
+    input  wire [2:0]  s_axil_arprot,  // ignored
+    // verilator lint_on UNUSEDSIGNAL
+    input  wire        s_axil_arvalid,
+    output wire        s_axil_arready,
+    output wire [31:0] s_axil_rdata,
+    output wire [1:0]  s_axil_rresp,
+    output wire        s_axil_rvalid,
+    input  wire        s_axil_rready,
+    // encoder and system
+    input  wire        a_in,           // encoder channel A, asynchronous
+    input  wire        b_in,           // encoder channel B, asynchronous
+    input  wire        z_in,           // index channel, asynchronous
+    input  wire        probe_in,       // external latch input, asynchronous
+    input  wire        snap_in,        // synchronous snapshot strobe
+    output wire        irq,            // level: any enabled pending event
+    output wire        cmp_out         // one-clock pulse on a compare match
+);
+
+  generate
+    if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w
+`ifdef __ICARUS__
+      enc_qei_axil__parameter_COUNT_W_must_be_8_to_64 u_stop ();
+`else
+      $error("enc_qei_axil: parameter COUNT_W must be in 8 .. 64");
+`endif
+    end
+    if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w
+`ifdef __ICARUS__
+      enc_qei_axil__parameter_TS_W_must_be_16_to_32 u_stop ();
+`else
+      $error("enc_qei_axil: parameter TS_W must be in 16 .. 32");
+`endif
+    end
+  endgenerate
+
+  // ---- channel registers -------------------------------------------------------------------------
+  reg        aw_v_q, w_v_q, ar_v_q;  // an address / data beat is held
+  reg [7:0]  awaddr_q, araddr_q;
+  reg [31:0] wdata_q;
+  reg [3:0]  wstrb_q;
+  reg        pend_q;                 // a request is in enc_qei (response next clock)
+  reg        pend_wr_q;              // ... and it is a write
+  reg        last_rd_q;              // the last request issued was a read (alternation)
+  reg        bvalid_q, rvalid_q;
+  reg        berr_q, rerr_q;
+  reg [31:0] rdata_q;
+
+  wire        resp_valid, resp_err;
+  wire [31:0] resp_rdata;
+
+  wire idle     = ~pend_q & ~bvalid_q & ~rvalid_q;
+  wire wr_ready = aw_v_q & w_v_q;
+  wire issue_rd = idle & ar_v_q & ~(wr_ready & last_rd_q);
+  wire issue_wr = idle & wr_ready & ~issue_rd;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      aw_v_q    <= 1'b0;
+      w_v_q     <= 1'b0;
+      ar_v_q    <= 1'b0;
+      awaddr_q  <= 8'd0;
+      araddr_q  <= 8'd0;
+      wdata_q   <= 32'd0;
+      wstrb_q   <= 4'd0;
+      pend_q    <= 1'b0;
+      pend_wr_q <= 1'b0;
+      last_rd_q <= 1'b0;
+      bvalid_q  <= 1'b0;
+      rvalid_q  <= 1'b0;
+      berr_q    <= 1'b0;
+      rerr_q    <= 1'b0;
+      rdata_q   <= 32'd0;
+    end else begin
+      if (s_axil_awvalid & ~aw_v_q) begin
+        aw_v_q   <= 1'b1;
+        awaddr_q <= s_axil_awaddr;
+      end else if (issue_wr) begin
+        aw_v_q <= 1'b0;
+      end
+      if (s_axil_wvalid & ~w_v_q) begin
+        w_v_q   <= 1'b1;
+        wdata_q <= s_axil_wdata;
+        wstrb_q <= s_axil_wstrb;
+      end else if (issue_wr) begin
+        w_v_q <= 1'b0;
+      end
+      if (s_axil_arvalid & ~ar_v_q) begin
+        ar_v_q   <= 1'b1;
+        araddr_q <= s_axil_araddr;
+      end else if (issue_rd) begin
+        ar_v_q <= 1'b0;
+      end
+      pend_q <= issue_rd | issue_wr;
+      if (issue_rd | issue_wr) begin
+        pend_wr_q <= issue_wr;
+        last_rd_q <= issue_rd;
+      end
+      if (resp_valid & pend_wr_q) begin
+        bvalid_q <= 1'b1;
+        berr_q   <= resp_err;
+      end else if (s_axil_bready) begin
+        bvalid_q <= 1'b0;
+      end
+      if (resp_valid & ~pend_wr_q) begin
+        rvalid_q <= 1'b1;
+        rerr_q   <= resp_err;
+        rdata_q  <= resp_rdata;
+      end else if (s_axil_rready) begin
+        rvalid_q <= 1'b0;
+      end
+    end
+  end
+
+  enc_qei #(
+      .COUNT_W(COUNT_W),
+      .TS_W   (TS_W)
+  ) u_qei (
+      .clk       (clk),
+      .rst       (rst),
+      .req_valid (issue_rd | issue_wr),
+      .req_write (issue_wr),
+      .req_addr  (issue_wr ? awaddr_q : araddr_q),
+      .req_wdata (wdata_q),
+      .req_wstrb (wstrb_q),
+      .resp_valid(resp_valid),
+      .resp_rdata(resp_rdata),
+      .resp_err  (resp_err),
+      .a_in      (a_in),
+      .b_in      (b_in),
+      .z_in      (z_in),
+      .probe_in  (probe_in),
+      .snap_in   (snap_in),
+      .irq       (irq),
+      .cmp_out   (cmp_out)
+  );
+
+  assign s_axil_awready = ~aw_v_q;
+  assign s_axil_wready  = ~w_v_q;
+  assign s_axil_arready = ~ar_v_q;
+  assign s_axil_bvalid  = bvalid_q;
+  assign s_axil_bresp   = berr_q ? 2'b10 : 2'b00;
+  assign s_axil_rvalid  = rvalid_q;
+  assign s_axil_rresp   = rerr_q ? 2'b10 : 2'b00;
+  assign s_axil_rdata   = rdata_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,453 @@
+// SPDX-License-Identifier: Apache-2.0
+// enc_qei_core -- the counting core of enc_qei: decode, count function, range, index, probe,
+// compare and the events they raise.
+//
+// Inputs are the conditioned channels (enc_conditioner_rt outputs). Channel A and B go through
+// SWAP_AB then INV_A / INV_B, then into the library's decoders, held in reset while the
+// conditioner is not valid and for one clock after FUNC, SWAP_AB, INV_A or INV_B change:
+//   enc_x4_decoder    -> every valid transition (cnt, up) and the quadrature error
+//   enc_x1_hysteresis -> FUNC = x1_hyst (Figure 14)
+// The Linux count functions come from the x4 decoder's transitions and the levels of the
+// transition's present and previous sample (a1/a2, b1/b2 below, aligned with its outputs):
+//   x4 every transition; x2a/x2b transitions of A/B; x1a: A rising forward (+1), A falling
+//   backward (-1); x1b the same on B; pulse_dir / increase / decrease: rising edges of A (B = up).
+// Count priority in one clock: COUNT write > index preset > count step. Range modes: free,
+// modulo (0 .. CEILING), limit (stops at 0 / CEILING), non_recycle (stops until COUNT is
+// written). Every decoder output has latency 1 from its sample; the index and probe edge
+// detectors are registered the same way, so all act in the clock of the transition they see.
+`default_nettype none
+
+module enc_qei_core #(
+    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)
+    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)
+) (
+    input  wire               clk,
+    input  wire               rst,            // synchronous, active high
+    // conditioned inputs
+    input  wire               a_c,            // channel A from the conditioner
+    input  wire               b_c,            // channel B
+    input  wire               z_c,            // index channel Z
+    input  wire               probe_c,        // probe input
+    input  wire               valid,          // conditioner outputs show the inputs
+    // configuration (CTRL, PRESET, CEILING, COMPARE, INDEX_CTRL, PROBE_CTRL)
+    input  wire               en,
+    input  wire               swap_ab,
+    input  wire               inv_a,
+    input  wire               inv_b,
+    input  wire               inv_z,
+    input  wire [3:0]         func,
+    input  wire [1:0]         range,
+    input  wire [COUNT_W-1:0] preset,
+    input  wire [COUNT_W-1:0] ceiling,
+    input  wire [COUNT_W-1:0] compare,
+    input  wire [1:0]         idx_action,
+    input  wire               idx_oneshot,
+    input  wire               idx_edge,       // 0 rising, 1 falling
+    input  wire               idx_gate_en,
+    input  wire               idx_gate_a,
+    input  wire               idx_gate_b,
+    input  wire               idx_arm,
+    input  wire               probe_en,
+    input  wire               probe_edge,     // 0 rising, 1 falling
+    input  wire               probe_once,
+    input  wire [TS_W-1:0]    timebase,
+    // COUNT_LO / COUNT_HI (external registers)
+    input  wire               count_lo_rd,    // read of COUNT_LO: latch the high word
+    input  wire               count_lo_wr,    // write of COUNT_LO: load the count
+    input  wire [31:0]        count_lo_wdata,
+    input  wire               count_hi_wr,    // write of COUNT_HI: stage the high word
+    input  wire [31:0]        count_hi_wdata,
+    output wire [31:0]        count_lo_rdata,
+    output wire [31:0]        count_hi_rdata,
+    // state
+    output wire [COUNT_W-1:0] count,
+    output wire [COUNT_W-1:0] idx_latch,
+    output wire [COUNT_W-1:0] probe_latch,
+    output wire [TS_W-1:0]    probe_time,
+    output wire               a_eff,          // A, B, Z as the decoders see them
+    output wire               b_eff,
+    output wire               z_eff,
+    output wire               dir,            // direction of the last count step, 1 = up
+    output wire               idx_armed,
+    output wire               stopped,        // non_recycle stopped
+    output wire               idx_disarm,     // one-shot index acted: clear INDEX_CTRL.ARM
+    output wire               probe_disarm,   // once-probe latched: clear PROBE_CTRL.EN
+    // for the timing unit
+    output wire               step_up,        // count function step (enabled, before the range)
+    output wire               step_dn,
+    output wire               applied_up,     // a step the count took
+    output wire               applied_dn,
+    output wire               edge_any,       // valid quadrature transition (latency as cnt)
+    output wire               edge_a_rise,    // rising edge of A
+    // events (one clock each)
+    output wire               ev_overflow,
+    output wire               ev_underflow,
+    output wire               ev_index,
+    output wire               ev_probe,
+    output wire               ev_cmp,
+    output wire               ev_qerr,
+    output wire               ev_dir_change,
+    output wire               cmp_out
+);
+
+  localparam [3:0] F_X4 = 4'd0, F_X2A = 4'd1, F_X2B = 4'd2, F_X1A = 4'd3, F_X1B = 4'd4,
+                   F_PULSE_DIR = 4'd5, F_INCREASE = 4'd6, F_DECREASE = 4'd7, F_X1_HYST = 4'd8;
+  localparam [1:0] R_FREE = 2'd0, R_MODULO = 2'd1, R_LIMIT = 2'd2, R_NON_RECYCLE = 2'd3;
+  localparam [1:0] I_PRESET = 2'd1, I_LATCH = 2'd2;
+
+  function [63:0] zext64;
+    input [COUNT_W-1:0] v;
+    begin
+      zext64 = 64'd0;
+      zext64[COUNT_W-1:0] = v;
+    end
+  endfunction
+
+  // ---- channel selection and decoder reset ----------------------------------------------------
+  wire a_sw = swap_ab ? b_c : a_c;
+  wire b_sw = swap_ab ? a_c : b_c;
+  assign a_eff = a_sw ^ inv_a;
+  assign b_eff = b_sw ^ inv_b;
+  assign z_eff = z_c ^ inv_z;
+
+  reg  [6:0] cfg_q;  // {func, swap_ab, inv_a, inv_b} last clock
+  wire [6:0] cfg   = {func, swap_ab, inv_a, inv_b};
+  wire       dec_rst = rst | ~valid | (cfg != cfg_q);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      cfg_q <= 7'd0;
+    end else begin
+      cfg_q <= cfg;
+    end
+  end
+
+  wire x4_cnt, x4_up, x4_err;
+  wire h_up, h_dn, h_err_unused;
+
+  enc_x4_decoder u_x4 (
+      .clk      (clk),
+      .rst      (dec_rst),
+      .a        (a_eff),
+      .b        (b_eff),
+      .cnt_pulse(x4_cnt),
+      .up       (x4_up),
+      .error    (x4_err)
+  );
+
+  enc_x1_hysteresis u_x1h (
+      .clk     (clk),
+      .rst     (dec_rst),
+      .a       (a_eff),
+      .b       (b_eff),
+      .up_pulse(h_up),
+      .dn_pulse(h_dn),
+      .error   (h_err_unused)  // the same condition as x4_err
+  );
+
+  // Levels of the present (1) and previous (2) sample of the transition the decoders report now,
+  // and A's rising edge for the pulse functions (registered like the decoders' outputs).
+  reg a1_q, a2_q, b1_q, b2_q, ok1_q, arise_q;
+
+  always @(posedge clk) begin
+    if (dec_rst) begin
+      ok1_q   <= 1'b0;
+      arise_q <= 1'b0;
+    end else begin
+      ok1_q   <= 1'b1;
+      arise_q <= ok1_q & a_eff & ~a1_q;
+    end
+    a1_q <= a_eff;
+    a2_q <= a1_q;
+    b1_q <= b_eff;
+    b2_q <= b1_q;
+  end
+
+  // ---- count function ---------------------------------------------------------------------------
+  wire a_moved = a1_q ^ a2_q;
+  wire b_moved = b1_q ^ b2_q;
+  reg  fup, fdn, quad;
+
+  always @(*) begin
+    fup  = 1'b0;
+    fdn  = 1'b0;
+    quad = 1'b1;
+    case (func)
+      F_X4: begin
+        fup = x4_cnt & x4_up;
+        fdn = x4_cnt & ~x4_up;
+      end
+      F_X2A: begin
+        fup = x4_cnt & a_moved & x4_up;
+        fdn = x4_cnt & a_moved & ~x4_up;
+      end
+      F_X2B: begin
+        fup = x4_cnt & b_moved & x4_up;
+        fdn = x4_cnt & b_moved & ~x4_up;
+      end
+      F_X1A: begin
+        fup = x4_cnt & a_moved & x4_up & a1_q;
+        fdn = x4_cnt & a_moved & ~x4_up & ~a1_q;
+      end
+      F_X1B: begin
+        fup = x4_cnt & b_moved & x4_up & b1_q;
+        fdn = x4_cnt & b_moved & ~x4_up & ~b1_q;
+      end
+      F_PULSE_DIR: begin
+        fup  = arise_q & b1_q;
+        fdn  = arise_q & ~b1_q;
+        quad = 1'b0;
+      end
+      F_INCREASE: begin
+        fup  = arise_q;
+        quad = 1'b0;
+      end
+      F_DECREASE: begin
+        fdn  = arise_q;
+        quad = 1'b0;
+      end
+      F_X1_HYST: begin
+        fup = h_up;
+        fdn = h_dn;
+      end
+      default: quad = 1'b0;
+    endcase
+  end
+
+  assign step_up     = en & fup;
+  assign step_dn     = en & fdn;
+  assign edge_any    = x4_cnt;
+  assign edge_a_rise = x4_cnt & a_moved & a1_q;
+  assign ev_qerr     = quad & x4_err;
+
+  // ---- range ---------------------------------------------------------------------------------------
+  reg  [COUNT_W-1:0] count_q;
+  reg  [COUNT_W-1:0] count_d;
+  reg                stopped_q;
+  reg                stopped_d;
+  reg  [31:0]        hi_stage_q;
+  reg  [31:0]        hi_latch_q;
+
+  wire at_zero = (count_q == {COUNT_W{1'b0}});
+  wire at_max  = (count_q == {COUNT_W{1'b1}});
+  wire at_ceil = (count_q >= ceiling);
+  wire [COUNT_W-1:0] count_inc = count_q + {{(COUNT_W-1){1'b0}}, 1'b1};
+  wire [COUNT_W-1:0] count_dec = count_q - {{(COUNT_W-1){1'b0}}, 1'b1};
+
+  reg [COUNT_W-1:0] stepped;  // count after this clock's step (before loads)
+  reg               ovf, unf, took;
+
+  always @(*) begin
+    stepped = count_q;
+    ovf     = 1'b0;
+    unf     = 1'b0;
+    took    = 1'b0;
+    stopped_d = stopped_q;
+    case (range)
+      R_FREE: begin
+        if (step_up) begin
+          stepped = count_inc;
+          ovf     = at_max;
+          took    = 1'b1;
+        end else if (step_dn) begin
+          stepped = count_dec;
+          unf     = at_zero;
+          took    = 1'b1;
+        end
+      end
+      R_MODULO: begin
+        if (step_up) begin
+          stepped = at_ceil ? {COUNT_W{1'b0}} : count_inc;
+          ovf     = at_ceil;
+          took    = 1'b1;
+        end else if (step_dn) begin
+          stepped = at_zero ? ceiling : count_dec;
+          unf     = at_zero;
+          took    = 1'b1;
+        end
+      end
+      R_LIMIT: begin
+        if (step_up) begin
+          stepped = at_ceil ? count_q : count_inc;
+          ovf     = at_ceil;
+          took    = ~at_ceil;
+        end else if (step_dn) begin
+          stepped = at_zero ? count_q : count_dec;
+          unf     = at_zero;
+          took    = ~at_zero;
+        end
+      end
+      R_NON_RECYCLE: begin
+        if (!stopped_q) begin
+          if (step_up) begin
+            stepped   = at_ceil ? count_q : count_inc;
+            ovf       = at_ceil;
+            took      = ~at_ceil;
+            stopped_d = at_ceil;
+          end else if (step_dn) begin
+            stepped   = at_zero ? count_q : count_dec;
+            unf       = at_zero;
+            took      = ~at_zero;
+            stopped_d = at_zero;
+          end
+        end
+      end
+    endcase
+    if (count_lo_wr) begin
+      stopped_d = 1'b0;
+    end
+  end
+
+  // ---- index ---------------------------------------------------------------------------------------
+  // Qualified index: Z and, with the gate, (A, B) = (GATE_A, GATE_B); the chosen edge of it acts.
+  wire idx_q      = z_eff & (~idx_gate_en | ((a_eff == idx_gate_a) & (b_eff == idx_gate_b)));
+  wire armed      = idx_arm & (idx_action != 2'd0);
+  reg  idx_prev_q, idx_ok_q, idx_hit_q;
+
+  always @(posedge clk) begin
+    if (rst | ~valid) begin
+      idx_prev_q <= 1'b0;
+      idx_ok_q   <= 1'b0;
+      idx_hit_q  <= 1'b0;
+    end else begin
+      idx_prev_q <= idx_q;
+      idx_ok_q   <= 1'b1;
+      idx_hit_q  <= idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+    end
+  end
+
+  wire idx_act    = idx_hit_q & armed;
+  wire idx_preset = idx_act & (idx_action == I_PRESET);
+  wire idx_latch_en = idx_act & (idx_action == I_LATCH);
+
+  // ---- count register ----------------------------------------------------------------------------
+  // verilator lint_off UNUSEDSIGNAL
+  wire [63:0] wr_value = {hi_stage_q, count_lo_wdata};  // (the bits above COUNT_W are dropped)
+  // verilator lint_on UNUSEDSIGNAL
+  wire        load     = count_lo_wr | idx_preset;
+
+  always @(*) begin
+    if (count_lo_wr) begin
+      count_d = wr_value[COUNT_W-1:0];
+    end else if (idx_preset) begin
+      count_d = preset;
+    end else begin
+      count_d = stepped;
+    end
+  end
+
+  reg upd_q;  // the count changed (step or load) at the last clock edge
+
+  always @(posedge clk) begin
+    if (rst) begin
+      count_q   <= {COUNT_W{1'b0}};
+      stopped_q <= 1'b0;
+      upd_q     <= 1'b0;
+    end else begin
+      count_q   <= count_d;
+      stopped_q <= stopped_d;
+      upd_q     <= load | took;
+    end
+  end
+
+  // COUNT_HI: the high word latched by a COUNT_LO read; the staged word for a COUNT_LO write.
+  wire [63:0] count64 = zext64(count_q);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      hi_latch_q <= 32'd0;
+      hi_stage_q <= 32'd0;
+    end else begin
+      if (count_lo_rd) begin
+        hi_latch_q <= count64[63:32];
+      end
+      if (count_hi_wr) begin
+        hi_stage_q <= count_hi_wdata;
+      end
+    end
+  end
+
+  assign count_lo_rdata = count64[31:0];
+  assign count_hi_rdata = hi_latch_q;
+
+  // ---- direction -----------------------------------------------------------------------------------
+  reg dir_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      dir_q <= 1'b1;
+    end else if (step_up | step_dn) begin
+      dir_q <= step_up;
+    end
+  end
+
+  assign ev_dir_change = (step_up & ~dir_q) | (step_dn & dir_q);
+
+  // ---- latches ---------------------------------------------------------------------------------------
+  reg [COUNT_W-1:0] idx_latch_q;
+  reg [COUNT_W-1:0] probe_latch_q;
+  reg [TS_W-1:0]    probe_time_q;
+  reg               probe_prev_q, probe_ok_q, probe_hit_q;
+
+  always @(posedge clk) begin
+    if (rst | ~valid) begin
+      probe_prev_q <= 1'b0;
+      probe_ok_q   <= 1'b0;
+      probe_hit_q  <= 1'b0;
+    end else begin
+      probe_prev_q <= probe_c;
+      probe_ok_q   <= 1'b1;
+      probe_hit_q  <= probe_ok_q & probe_en &
+                      (probe_edge ? (probe_prev_q & ~probe_c) : (~probe_prev_q & probe_c));
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      idx_latch_q   <= {COUNT_W{1'b0}};
+      probe_latch_q <= {COUNT_W{1'b0}};
+      probe_time_q  <= {TS_W{1'b0}};
+    end else begin
+      if (idx_latch_en) begin
+        idx_latch_q <= stepped;
+      end
+      if (probe_hit_q) begin
+        probe_latch_q <= count_q;
+        probe_time_q  <= timebase;
+      end
+    end
+  end
+
+  // ---- compare ---------------------------------------------------------------------------------------
+  reg cmp_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      cmp_q <= 1'b0;
+    end else begin
+      cmp_q <= upd_q & (count_q == compare);
+    end
+  end
+
+  // ---- outputs ---------------------------------------------------------------------------------------
+  assign count        = count_q;
+  assign idx_latch    = idx_latch_q;
+  assign probe_latch  = probe_latch_q;
+  assign probe_time   = probe_time_q;
+  assign dir          = dir_q;
+  assign idx_armed    = armed;
+  assign stopped      = stopped_q;
+  assign idx_disarm   = idx_act & idx_oneshot;
+  assign probe_disarm = probe_hit_q & probe_once;
+  assign applied_up   = took & step_up & ~load;
+  assign applied_dn   = took & step_dn & ~load;
+  assign ev_overflow  = ovf;
+  assign ev_underflow = unf;
+  assign ev_index     = idx_hit_q;
+  assign ev_probe     = probe_hit_q;
+  assign ev_cmp       = cmp_q;
+  assign cmp_out      = cmp_q;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: Apache-2.0
+// enc_qei_wb -- enc_qei with a Wishbone B4 classic slave port (32-bit data, byte address).
+//
+// A thin adapter: a strobe of the bus (wb_cyc_i & wb_stb_i) is one request to enc_qei, whose
+// response one clock later is the acknowledge -- wb_ack_o, or wb_err_o for an unmapped offset
+// (which reads 0 and writes nothing). So every access takes two clocks and always completes. No
+// new request starts in the clock of an acknowledge (the master still holds its strobe then).
+// wb_sel_i are the byte enables of a write. All the peripheral's behaviour is in enc_qei.
+`default_nettype none
+
+module enc_qei_wb #(
+    parameter integer COUNT_W = 32,  // counter width: 8 .. 64
+    parameter integer TS_W    = 32   // timebase / timestamp width: 16 .. 32
+) (
+    input  wire        clk,
+    input  wire        rst,       // synchronous, active high
+    // Wishbone B4 classic slave
+    input  wire [7:0]  wb_adr_i,  // byte address (bits 1:0 ignored)
+    input  wire [31:0] wb_dat_i,
+    output wire [31:0] wb_dat_o,
+    input  wire [3:0]  wb_sel_i,
+    input  wire        wb_we_i,
+    input  wire        wb_stb_i,
+    input  wire        wb_cyc_i,
+    output wire        wb_ack_o,
+    output wire        wb_err_o,
+    // encoder and system
+    input  wire        a_in,      // encoder channel A, asynchronous
+    input  wire        b_in,      // encoder channel B, asynchronous
+    input  wire        z_in,      // index channel, asynchronous
+    input  wire        probe_in,  // external latch input, asynchronous
+    input  wire        snap_in,   // synchronous snapshot strobe
+    output wire        irq,       // level: any enabled pending event
+    output wire        cmp_out    // one-clock pulse on a compare match
+);
+
+  generate
+    if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w
+`ifdef __ICARUS__
+      enc_qei_wb__parameter_COUNT_W_must_be_8_to_64 u_stop ();
+`else
+      $error("enc_qei_wb: parameter COUNT_W must be in 8 .. 64");
+`endif
+    end
+    if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w
+`ifdef __ICARUS__
+      enc_qei_wb__parameter_TS_W_must_be_16_to_32 u_stop ();
+`else
+      $error("enc_qei_wb: parameter TS_W must be in 16 .. 32");
+`endif
+    end
+  endgenerate
+
+  wire resp_valid, resp_err;
+
+  enc_qei #(
+      .COUNT_W(COUNT_W),
+      .TS_W   (TS_W)
+  ) u_qei (
+      .clk       (clk),
+      .rst       (rst),
+      .req_valid (wb_cyc_i & wb_stb_i & ~resp_valid),
+      .req_write (wb_we_i),
+      .req_addr  (wb_adr_i),
+      .req_wdata (wb_dat_i),
+      .req_wstrb (wb_sel_i),
+      .resp_valid(resp_valid),
+      .resp_rdata(wb_dat_o),
+      .resp_err  (resp_err),
+      .a_in      (a_in),
+      .b_in      (b_in),
+      .z_in      (z_in),
+      .probe_in  (probe_in),
+      .snap_in   (snap_in),
+      .irq       (irq),
+      .cmp_out   (cmp_out)
+  );
+
+  assign wb_ack_o = wb_cyc_i & resp_valid & ~resp_err;
+  assign wb_err_o = wb_cyc_i & resp_valid & resp_err;
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,372 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Generate everything that depends on the enc_qei register map from rtl/enc_qei.rdl.
+
+Outputs (all committed):
+  sw/enc_qei_regs.h    C header (peakrdl-cheader)
+  doc/enc_qei_regs.md  register reference (peakrdl-markdown)
+  rtl/enc_qei_regs.v   the register block of the peripheral: address decode, storage, byte
+                       enables, write-1-to-clear, counters and read multiplexer, generated from the
+                       compiled RDL (a Verilog module rather than an `include file: every flow
+                       here compiles rtl/*.v without include paths)
+
+  scripts/gen_regs.py           regenerate
+  scripts/gen_regs.py --check   exit 1, naming the stale file(s), if a committed output differs
+
+Field kinds the Verilog generator understands (anything else stops it with a message):
+  sw=r  hw=na            constant (the reset value)
+  sw=r  hw=w             live value from the hardware: input <reg>_<field>
+  sw=rw hw=r             configuration storage: output <reg>_<field>
+  ... with hwclr         plus input <reg>_<field>_hwclr (software write wins in the same clock)
+  sw=w  singlepulse      output <reg>_<field>: a one-clock pulse when 1 is written
+  intr, onwrite=woclr    event bit: input <reg>_<field>_set (wins over a clear in the same clock)
+  counter incrsaturate onwrite=wclr   saturating counter: input <reg>_<field>_incr; a write clears
+  external register      held by the hardware: input <reg>_rdata, outputs <reg>_rd (read strobe),
+                         <reg>_wr (write strobe) and <reg>_wdata (written word merged with
+                         <reg>_rdata on the byte lanes not enabled)
+User property sized_by ("COUNT_W:0", "COUNT_W:1", "TS_W"): storage keeps only the bits of the
+value; the others read 0 and ignore writes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import difflib
+import sys
+import tempfile
+from pathlib import Path
+
+TOP = Path(__file__).resolve().parent.parent
+RDL = TOP / "rtl" / "enc_qei.rdl"
+OUT_H = TOP / "sw" / "enc_qei_regs.h"
+OUT_MD = TOP / "doc" / "enc_qei_regs.md"
+OUT_V = TOP / "rtl" / "enc_qei_regs.v"
+
+SIZE_MASKS = {"COUNT_W:0": "SZ_COUNT_LO", "COUNT_W:1": "SZ_COUNT_HI", "TS_W": "SZ_TS"}
+
+
+def compile_rdl(path: Path = RDL):
+    """Compile and elaborate the RDL; return the top addrmap node."""
+    from systemrdl import RDLCompiler
+
+    rdlc = RDLCompiler()
+    rdlc.compile_file(str(path))
+    return rdlc.elaborate().top
+
+
+def field_kind(f) -> str:
+    sw, hw = f.get_property("sw").name, f.get_property("hw").name
+    onwrite = f.get_property("onwrite")
+    ow = onwrite.name if onwrite is not None else None
+    if f.parent.external:
+        return "ext"
+    if f.get_property("intr") and ow == "woclr" and sw == "rw":
+        return "intr"
+    if f.get_property("counter") and f.get_property("incrsaturate") and ow == "wclr" and sw == "rw":
+        return "counter"
+    if sw == "r" and hw == "na":
+        return "const"
+    if sw == "r" and hw == "w":
+        return "in"
+    if sw == "rw" and hw in ("r", "rw") and ow is None:
+        return "cfg"
+    if sw == "w" and f.get_property("singlepulse"):
+        return "pulse"
+    raise SystemExit(f"gen_regs: field {f.get_path()} (sw={sw}, hw={hw}, onwrite={ow}) is a kind the "
+                     "Verilog generator does not handle")
+
+
+def vname(*parts: str) -> str:
+    return "_".join(p.lower() for p in parts)
+
+
+def verilog(top) -> str:
+    regs = list(top.registers())
+    ports: list[str] = []
+    body: list[str] = []
+    rd_cases: list[str] = []
+    addr_params: list[str] = []
+
+    for r in regs:
+        idx = r.address_offset >> 2
+        rn = r.inst_name
+        addr_params.append(f"  localparam [5:0] A_{rn} = 6'd{idx};  // 0x{r.address_offset:02X}")
+        rd_lines: list[str] = []
+        if r.external:
+            base = vname(rn)
+            (fld,) = list(r.fields())
+            if fld.lsb != 0 or fld.width != 32:
+                raise SystemExit(f"gen_regs: external register {rn} must have one 32-bit field")
+            ports += [f"    input  wire [31:0] {base}_rdata,  // {rn}: value held by the hardware",
+                      f"    output wire        {base}_rd,     // {rn}: read strobe",
+                      f"    output wire        {base}_wr,     // {rn}: write strobe",
+                      f"    output wire [31:0] {base}_wdata,  // {rn}: written word (merged byte lanes)"]
+            sz = SIZE_MASKS.get(fld.get_property("sized_by"), None)
+            m = f"(bmask & {sz})" if sz else "bmask"
+            body += [f"  assign {base}_rd    = rd_req & (req_addr[7:2] == A_{rn});",
+                     f"  assign {base}_wr    = wr_req & (req_addr[7:2] == A_{rn}) & (|req_wstrb);",
+                     f"  assign {base}_wdata = ({base}_rdata & ~{m}) | (req_wdata & {m});", ""]
+            rd_lines.append(f"        rd_d = {base}_rdata;")
+            rd_cases.append((rn, rd_lines))
+            continue
+        for f in r.fields():
+            kind = field_kind(f)
+            w, lsb, msb = f.width, f.lsb, f.msb
+            name = vname(rn, f.inst_name)
+            rng = f"[{w - 1}:0] " if w > 1 else ""
+            sl = f"[{msb}:{lsb}]"
+            reset = f.get_property("reset")
+            sz = SIZE_MASKS.get(f.get_property("sized_by"), None)
+            desc = f"{rn}.{f.inst_name}"
+            wmask = f"bmask{sl}" + (f" & {sz}{sl}" if sz else "")
+            rst_val = f"{w}'h{(reset or 0):X}" + (f" & {sz}{sl}" if sz else "")
+            if kind == "const":
+                rd_lines.append(f"        rd_d{sl} = {w}'h{reset:X};  // {desc}")
+            elif kind == "in":
+                ports.append(f"    input  wire {rng}{name},  // {desc}")
+                rd_lines.append(f"        rd_d{sl} = {name};")
+            elif kind in ("cfg", "intr", "counter"):
+                q = f"{name}_q"
+                body.append(f"  reg {rng}{q};  // {desc}")
+                ports.append(f"    output wire {rng}{name},  // {desc}")
+                body.append(f"  assign {name} = {q};")
+                wr = f"wr_req & (req_addr[7:2] == A_{rn})"
+                body.append("  always @(posedge clk) begin")
+                body.append(f"    if (rst) begin")
+                body.append(f"      {q} <= {rst_val};")
+                if kind == "cfg":
+                    hwclr = f.get_property("hwclr")
+                    if hwclr:
+                        ports.append(f"    input  wire {name}_hwclr,  // {desc}: hardware clear")
+                        body.append(f"    end else if ({wr} & (|({wmask}))) begin")
+                        body.append(f"      {q} <= ({q} & ~({wmask})) | (req_wdata{sl} & {wmask});")
+                        body.append(f"    end else if ({name}_hwclr) begin")
+                        body.append(f"      {q} <= {w}'d0;")
+                    else:
+                        body.append(f"    end else if ({wr}) begin")
+                        body.append(f"      {q} <= ({q} & ~({wmask})) | (req_wdata{sl} & {wmask});")
+                elif kind == "intr":
+                    ports.append(f"    input  wire {rng}{name}_set,  // {desc}: set (one clock)")
+                    body.append("    end else begin")
+                    body.append(f"      {q} <= ({q} & ~({{{w}{{{wr}}}}} & req_wdata{sl} & {wmask})) "
+                                f"| {name}_set;")
+                else:  # counter
+                    ports.append(f"    input  wire {name}_incr,  // {desc}: count one (saturating)")
+                    body.append(f"    end else if ({wr} & (|req_wstrb)) begin")
+                    body.append(f"      {q} <= {{{{{w - 1}{{1'b0}}}}, {name}_incr}};")
+                    body.append(f"    end else if ({name}_incr & ~(&{q})) begin")
+                    body.append(f"      {q} <= {q} + {w}'d1;")
+                body.append("    end")
+                body.append("  end")
+                body.append("")
+                rd_lines.append(f"        rd_d{sl} = {q};")
+            elif kind == "pulse":
+                q = f"{name}_q"
+                body.append(f"  reg {rng}{q};  // {desc}: one-clock pulse")
+                ports.append(f"    output wire {rng}{name},  // {desc}: one-clock pulse on a write of 1")
+                body.append(f"  assign {name} = {q};")
+                body.append("  always @(posedge clk) begin")
+                body.append(f"    if (rst) {q} <= {w}'d0;")
+                body.append(f"    else {q} <= {{{w}{{wr_req & (req_addr[7:2] == A_{rn})}}}} & "
+                            f"req_wdata{sl} & {wmask};")
+                body.append("  end")
+                body.append("")
+            else:
+                raise AssertionError(kind)
+        rd_cases.append((rn, rd_lines))
+
+    lines = [
+        "// SPDX-License-Identifier: Apache-2.0",
+        "// enc_qei_regs -- the register block of enc_qei: address decode, storage, byte enables,",
+        "// write-1-to-clear events, saturating counters and the read multiplexer.",
+        "//",
+        "// GENERATED by scripts/gen_regs.py from rtl/enc_qei.rdl -- do not edit; run `make regs`.",
+        "//",
+        "// Request/response port: a request is one clock of req_valid with req_write, req_addr (byte",
+        "// address, bits 1:0 ignored), req_wdata and req_wstrb. The response comes in the next clock:",
+        "// one clock of resp_valid with resp_rdata (0 for writes) and resp_err (unmapped offset: reads",
+        "// 0, writes nothing). Read side effects (external registers' _rd strobes) and writes take",
+        "// effect in the request clock.",
+        "`default_nettype none",
+        "",
+        "module enc_qei_regs #(",
+        "    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)",
+        "    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)",
+        ") (",
+        "    input  wire        clk,",
+        "    input  wire        rst,         // synchronous, active high",
+        "    input  wire        req_valid,   // one-clock request",
+        "    input  wire        req_write,   // 1 = write, 0 = read",
+        "    // verilator lint_off UNUSEDSIGNAL",
+        "    input  wire [7:0]  req_addr,    // byte address (bits 1:0 ignored)",
+        "    // verilator lint_on UNUSEDSIGNAL",
+        "    input  wire [31:0] req_wdata,",
+        "    input  wire [3:0]  req_wstrb,   // byte enables",
+        "    output wire        resp_valid,  // the clock after req_valid",
+        "    output wire [31:0] resp_rdata,",
+        "    output wire        resp_err,    // unmapped offset",
+    ]
+    ports[-1] = ports[-1].replace(",  //", "   //", 1)
+    lines += ports
+    lines += [
+        ");",
+        "",
+        "  // Register offsets (word index = byte offset / 4)",
+        *addr_params,
+        "",
+        "  // Bits of the value a sized field holds (the others read 0 and ignore writes)",
+        "  localparam [63:0] SZ_COUNT = (COUNT_W >= 64) ? {64{1'b1}} : ((64'd1 << COUNT_W) - 64'd1);",
+        "  localparam [31:0] SZ_COUNT_LO = SZ_COUNT[31:0];",
+        "  localparam [31:0] SZ_COUNT_HI = SZ_COUNT[63:32];",
+        "  localparam [31:0] SZ_TS = (TS_W >= 32) ? 32'hFFFFFFFF : ((32'd1 << TS_W) - 32'd1);",
+        "",
+        "  wire        wr_req = req_valid & req_write;",
+        "  wire        rd_req = req_valid & ~req_write;",
+        "  wire [31:0] bmask  = {{8{req_wstrb[3]}}, {8{req_wstrb[2]}}, {8{req_wstrb[1]}}, {8{req_wstrb[0]}}};",
+        "",
+    ]
+    lines += body
+    lines += [
+        "  // ---- read multiplexer and response ----------------------------------------------------",
+        "  reg [31:0] rd_d;",
+        "  reg        hit_d;",
+        "",
+        "  always @(*) begin",
+        "    rd_d  = 32'd0;",
+        "    hit_d = 1'b1;",
+        "    case (req_addr[7:2])",
+    ]
+    for rn, rd_lines in rd_cases:
+        lines.append(f"      A_{rn}: begin")
+        lines += rd_lines or ["        rd_d = 32'd0;"]
+        lines.append("      end")
+    lines += [
+        "      default: hit_d = 1'b0;",
+        "    endcase",
+        "  end",
+        "",
+        "  reg        resp_valid_q;",
+        "  reg [31:0] resp_rdata_q;",
+        "  reg        resp_err_q;",
+        "",
+        "  always @(posedge clk) begin",
+        "    if (rst) begin",
+        "      resp_valid_q <= 1'b0;",
+        "      resp_rdata_q <= 32'd0;",
+        "      resp_err_q   <= 1'b0;",
+        "    end else begin",
+        "      resp_valid_q <= req_valid;",
+        "      resp_rdata_q <= (rd_req & hit_d) ? rd_d : 32'd0;",
+        "      resp_err_q   <= req_valid & ~hit_d;",
+        "    end",
+        "  end",
+        "",
+        "  assign resp_valid = resp_valid_q;",
+        "  assign resp_rdata = resp_rdata_q;",
+        "  assign resp_err   = resp_err_q;",
+        "",
+        "endmodule",
+        "",
+        "`default_nettype wire",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def c_header(top, path: Path) -> None:
+    from peakrdl_cheader.exporter import CHeaderExporter
+
+    CHeaderExporter().export(top, str(path))
+    text = path.read_text()
+    # peakrdl-cheader gives masks, positions and the register struct; add byte offsets and the
+    # enum values (it exports neither) inside the include guard.
+    extra = ["", "// Register byte offsets"]
+    for r in top.registers():
+        extra.append(f"#define ENC_QEI_{r.inst_name}_OFFSET 0x{r.address_offset:02X}u")
+    extra += ["", "// Field enumerations: ENC_QEI__<REG>__<FIELD>__<member>"]
+    for r, f, enum in enum_fields(top):
+        for m in enum:
+            extra.append(f"#define ENC_QEI__{r.inst_name}__{f.inst_name}__{m.name.upper()} {m.value}u")
+    tail = "#ifdef __cplusplus\n}\n#endif\n\n#endif /* ENC_QEI_REGS_H */"
+    assert text.rstrip().endswith(tail), "unexpected peakrdl-cheader output layout"
+    text = text.rstrip()[: -len(tail)] + "\n".join(extra) + "\n\n" + tail + "\n"
+    head = ("// SPDX-License-Identifier: Apache-2.0\n"
+            "// GENERATED by scripts/gen_regs.py from rtl/enc_qei.rdl -- do not edit; run `make regs`.\n")
+    path.write_text(head + text)
+
+
+def enum_fields(top):
+    """(register, field, enum type) for every field encoded by a SystemRDL enum."""
+    out = []
+    for r in top.registers():
+        for f in r.fields():
+            enum = f.get_property("encode")
+            if enum is not None:
+                out.append((r, f, enum))
+    return out
+
+
+def markdown(top, path: Path) -> None:
+    from peakrdl_markdown import MarkdownExporter
+
+    MarkdownExporter().export(top, str(path))
+    text = path.read_text()
+    head = ("<!-- SPDX-License-Identifier: Apache-2.0 -->\n"
+            "<!-- GENERATED by scripts/gen_regs.py from rtl/enc_qei.rdl -- do not edit; run `make regs`. -->\n\n")
+    enums = ["", "## Field enumerations", ""]
+    for r, f, enum in enum_fields(top):
+        enums += [f"### {r.inst_name}.{f.inst_name}", "", "| Value | Name | Meaning |", "|---|---|---|"]
+        for m in enum:
+            desc = (m.rdl_desc or "").replace("|", "/").replace("\n", " ")
+            enums.append(f"| {m.value} | `{m.name}` | {desc} |")
+        enums.append("")
+    path.write_text(head + text.rstrip() + "\n" + "\n".join(enums))
+
+
+def generate(out_dir: Path | None = None) -> dict[Path, Path]:
+    """Write every output; with out_dir, into it instead of the tree. Returns {tree path: written}."""
+    top = compile_rdl()
+    targets = {OUT_H: c_header, OUT_MD: markdown}
+    written = {}
+    for dest, fn in targets.items():
+        path = (out_dir / dest.name) if out_dir else dest
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fn(top, path)
+        written[dest] = path
+    vpath = (out_dir / OUT_V.name) if out_dir else OUT_V
+    vpath.write_text(verilog(top))
+    written[OUT_V] = vpath
+    return written
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--check", action="store_true",
+                    help="do not write; exit 1 if a committed output differs from what the RDL generates")
+    args = ap.parse_args()
+    if not args.check:
+        for dest in generate():
+            print(f"gen_regs: wrote {dest.relative_to(TOP)}")
+        return 0
+    stale = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for dest, fresh in generate(Path(tmp)).items():
+            rel = dest.relative_to(TOP)
+            if not dest.exists():
+                stale.append(f"{rel} (missing)")
+                continue
+            old, new = dest.read_text(), fresh.read_text()
+            if old != new:
+                diff = difflib.unified_diff(old.splitlines(), new.splitlines(), str(rel), "generated",
+                                            lineterm="", n=1)
+                print("\n".join(list(diff)[:40]), file=sys.stderr)
+                stale.append(str(rel))
+    if stale:
+        print("gen_regs --check: stale (run `make regs`): " + ", ".join(stale), file=sys.stderr)
+        return 1
+    print("gen_regs --check: every output matches rtl/enc_qei.rdl")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
