@@ -508,13 +508,13 @@ def run_sim(args, units, rpms) -> dict:
         plans.append((gi, path, tmp / f"out_{gi}.json", tmp / f"progress_{gi}.txt"))
     total = len(cases)
     print(f"sim layer: {total} cases (units {', '.join(n for n, _ in units[:SIM_UNITS])}; "
-          f"{len({c['rpm'] for c in cases})} speeds x any/A-rising) on {sim}, "
+          f"{len({c['rpm'] for c in cases if c['kind'] == 'constant'})} speeds x any/A-rising, and a stop) on {sim}, "
           f"{len(groups)} process(es)", flush=True)
     t0 = time.perf_counter()
     errors = {}
 
     def one(gi, plan, out, prog):
-        env = {"VEL_PLAN": str(plan), "VEL_OUT": str(out), "VEL_PROGRESS": str(prog),
+        env = {"ENC_VEL_PLAN": str(plan), "ENC_VEL_OUT": str(out), "ENC_VEL_PROGRESS": str(prog),
                "COCOTB_LOG_LEVEL": "WARNING"}
         try:
             run("enc_qei_wb", "velocity_bench_sim", name=f"velocity_sim_{gi}",
@@ -552,6 +552,7 @@ def run_sim(args, units, rpms) -> dict:
         if out.exists():
             for r in json.loads(out.read_text()):
                 raw[r["id"]] = r
+    shutil.rmtree(tmp, ignore_errors=True)
     if errors and not raw:
         return {"skipped": f"the simulation failed ({'; '.join(errors.values())}; logs in "
                 f"sim/build/{sim}/velocity_sim_*/)", "wall_s": wall}

@@ -8,10 +8,10 @@ SNAP_EDGE_DELTA, PERIOD, PERIOD_CTRL and STATUS. No verdicts here: the host scri
 raw words into readings and compares them with the model.
 
 Environment (set by scripts/velocity_bench.py):
-  VEL_PLAN  JSON: clk_ps, regs {name: byte offset}, bits {"REG.FIELD": lsb}, cases [{id,
+  ENC_VEL_PLAN  JSON: clk_ps, regs {name: byte offset}, bits {"REG.FIELD": lsb}, cases [{id,
             events [[t_ns, a, b]...] (relative to the case start), reads_ns [...], edge (0 any,
             1 a_rising), prescale, period_n, stall_ticks}]
-  VEL_OUT   JSON written at the end: per case the calibration (sim time and TIMEBASE of one read
+  ENC_VEL_OUT   JSON written at the end: per case the calibration (sim time and TIMEBASE of one read
             before the waveform starts), the case start time, and per read the sim time of the
             SNAP_CTRL write's acknowledge and the raw register words.
 """
@@ -70,7 +70,7 @@ async def _until(t_ps: float) -> None:
 
 @cocotb.test()
 async def velocity_reads(dut):
-    plan = json.loads(open(os.environ["VEL_PLAN"]).read())
+    plan = json.loads(open(os.environ["ENC_VEL_PLAN"]).read())
     clk_ps = int(plan["clk_ps"])
     bits = plan["bits"]
     for name in ("a_in", "b_in", "z_in", "probe_in", "snap_in", "wb_cyc_i", "wb_stb_i",
@@ -84,7 +84,7 @@ async def velocity_reads(dut):
     bus = Bus(dut, plan["regs"])
     drv = QuadratureDriver(dut.a_in, dut.b_in, clock_period_ps=clk_ps)
     out = []
-    progress = os.environ.get("VEL_PROGRESS")
+    progress = os.environ.get("ENC_VEL_PROGRESS")
     for ci, case in enumerate(plan["cases"]):
         events = [tuple(e) for e in case["events"]]
         wf = Waveform(events=events, positions=[None] * len(events))
@@ -117,5 +117,5 @@ async def velocity_reads(dut):
         if progress:
             with open(progress, "a") as fh:
                 fh.write(f"{case['id']}\n")
-    with open(os.environ["VEL_OUT"], "w") as fh:
+    with open(os.environ["ENC_VEL_OUT"], "w") as fh:
         json.dump(out, fh)
