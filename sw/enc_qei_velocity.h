@@ -104,6 +104,38 @@ qei_vel_reading_t qei_vel_update(qei_vel_t *st, const qei_vel_snap_t *snap);
  * 500-cycle HEDS-5000: 2000). */
 double qei_vel_rpm(double counts_per_s, unsigned counts_per_rev);
 
+/*
+ * Reading the registers. Include the generated sw/enc_qei_regs.h (C11: it uses static_assert)
+ * before this header and qei_vel_read_snapshot() is defined: it takes a snapshot by bus command
+ * (SNAP_CTRL.CMD, keeping the other SNAP_CTRL fields) and reads it, with PERIOD, PERIOD_CTRL and
+ * STATUS right after (those three are live values, not latched with the snapshot). count_w is
+ * CAPS.COUNT_W. On a bus that posts writes, make sure the SNAP_CTRL write lands before the
+ * reads (a barrier, or read SNAP_CTRL back first).
+ */
+#ifdef ENC_QEI_REGS_H
+static inline void qei_vel_read_snapshot(volatile enc_qei_t *q, unsigned count_w,
+                                         qei_vel_snap_t *s)
+{
+    uint32_t pc, st;
+    q->SNAP_CTRL = (q->SNAP_CTRL & ~(uint32_t)ENC_QEI__SNAP_CTRL__CMD_bm) |
+                   ENC_QEI__SNAP_CTRL__CMD_bm;
+    s->count = q->SNAP_COUNT_LO;
+    if (count_w > 32u)
+        s->count |= (uint64_t)q->SNAP_COUNT_HI << 32;
+    s->time = q->SNAP_TIME;
+    s->edge_time = q->SNAP_EDGE_TIME;
+    s->delta = (int32_t)q->SNAP_DELTA;
+    s->edge_delta = (int32_t)q->SNAP_EDGE_DELTA;
+    s->period = q->PERIOD;
+    pc = q->PERIOD_CTRL;
+    st = q->STATUS;
+    s->period_n = (pc & ENC_QEI__PERIOD_CTRL__N_bm) >> ENC_QEI__PERIOD_CTRL__N_bp;
+    s->period_ovf = (uint8_t)((pc & ENC_QEI__PERIOD_CTRL__OVERFLOW_bm) != 0u);
+    s->period_dir_change = (uint8_t)((pc & ENC_QEI__PERIOD_CTRL__DIR_CHANGE_bm) != 0u);
+    s->stalled = (uint8_t)((st & ENC_QEI__STATUS__STALLED_bm) != 0u);
+}
+#endif
+
 #ifdef __cplusplus
 }
 #endif

@@ -326,3 +326,23 @@ def test_goals_on_a_typical_unit(seed):
     ).run(ex)]
     added = np.max(np.abs(np.subtract(r_hw, r_ex))[20:]) / 30
     assert added < 1e-3, added
+
+
+def test_register_reader_with_the_generated_header(tmp_path):
+    """qei_vel_read_snapshot() (defined when sw/enc_qei_regs.h is included first) writes
+    SNAP_CTRL.CMD keeping EDGE and fills the snapshot from the generated register struct."""
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("gcc not found")
+    if not (SW / "enc_qei_regs.h").exists():
+        pytest.skip("sw/enc_qei_regs.h is not generated")
+    exe = tmp_path / "vel_regs_check"
+    cmd = [gcc, "-std=c11", "-Wall", "-Wextra", "-Werror", f"-I{SW}",
+           str(Path(__file__).parent / "vel_regs_check.c"), str(SW / "enc_qei_velocity.c"),
+           "-o", str(exe)]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    assert res.returncode == 0, f"gcc failed:\n{' '.join(cmd)}\n{res.stderr}"
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split("\n")
+    # SNAP_CTRL = EDGE | CMD; count 64-bit; delta -5; edge delta -4; PERIOD 77, N 3, flags 0 1; stalled
+    assert out[0] == "9 2fffffff0 1000 900 -5 -4 77 3 0 1 1", out
+    assert out[1] == "fffffff0", out
