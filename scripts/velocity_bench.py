@@ -978,18 +978,34 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
     # goals
     verdicts = goals(args, units, model, sim)
     L += ["## Goals (issue 13)", ""] + [f"- {v}" for v in verdicts] + [""]
+    k = "MT/a_rising"
+    fl_lo = [C[r][u][k]["floor_rms"] for r in rpms if r < 100 for u in typ if k in C[r][u]]
+    fl_hi = [C[r][u][k]["floor_rms"] for r in rpms if r >= 1000 for u in typ if k in C[r][u]]
+    ecc = [usum[u]["ecc_mm"] for u in typ]
+    rng_txt = (lambda v: f"{fmt_pct(min(v), 2)}–{fmt_pct(max(v), 2)} %" if v else "—")
+    mt_any_ok = [r for r in rpms if all(
+        C[r][u].get("MT/any", {}).get("rms", math.inf)
+        <= 1.25 * C[r][u].get(k, {}).get("rms", 0) for u in typ)]
     L += ["## Recommendation", "",
           "- Use **M/T on A-rising edges** (SNAP_CTRL.EDGE = a_rising, SNAP_EDGE_DELTA / Δ "
-          "SNAP_EDGE_TIME) at every speed: its error is the encoder's own (cycle error and "
-          "eccentricity, ~0.1–0.3 % rms on a typical unit, the once-per-revolution eccentricity "
-          "term dominating above ~300 rpm) and the standstill rule keeps it off 0 down to one "
-          "cycle per stall timeout.",
-          "- **Any-edge timing** only helps when many states fit in one reading (M/T any edge "
-          "above ~3,000 rpm, where it equals A↑); below that it inherits ΔS / 90° per edge pair.",
+          "SNAP_EDGE_TIME) at every speed. Its error is the encoder's own: below 100 rpm, where "
+          "a reading spans one or a few cycles, the cycle error of its two edges ("
+          f"{rng_txt(fl_lo)} rms on the non-ideal units); above 1,000 rpm, where it spans many "
+          "cycles, the once-per-revolution speed ripple of the code wheel's eccentricity "
+          f"({rng_txt(fl_hi)} rms for {min(ecc) if ecc else 0:.3f}–{max(ecc) if ecc else 0:.3f} "
+          "mm TIR; being tied to the shaft angle, a host could calibrate it out against the "
+          "index). The standstill rule keeps it off 0 down to one cycle per stall timeout "
+          f"({60 / (500 * args.stall_ms * 1e-3):.2g} rpm with {args.stall_ms:g} ms), and a stop "
+          "reads 0 one stall timeout after the last edge.",
+          "- **Any-edge timing** inherits the state-width error, ΔS / (90° − ΔS) per edge pair "
+          "(tens of %): T on any edge never recovers; M/T on any edge only when many states fit "
+          "in one read (within 25 % of A↑ from "
+          f"{min(mt_any_ok):g} rpm)." if mt_any_ok else "(never within 25 % of A↑ here).",
           "- **M** (unit time) is exact on average but quantised to one count per read period "
-          "(30 rpm at 1 kHz): 0 or 30 rpm below 30 rpm, ±1 count in the reading above.",
-          "- **T** (one edge period) on A-rising edges is a good low-speed method (one cycle), but "
-          "at high speed it sees one cycle's error, unaveraged: prefer M/T there.", ""]
+          "(30 rpm at 1 kHz): it reads 0 or 30 rpm below 30 rpm and ±1 count above; use it only "
+          "where the count per read is large (it matches M/T A↑ near 12,000 rpm).",
+          "- **T** on A-rising edges equals M/T at low speed (one cycle per reading) and needs no "
+          "snapshot; at high speed it sees one cycle's error unaveraged: prefer M/T there.", ""]
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(L))
     return verdicts
