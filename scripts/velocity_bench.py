@@ -711,7 +711,9 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
          "SNAP_EDGE_DELTA against the model's count between the matched edges, PERIOD against "
          "the model's time between them (±2 ticks), SNAP_DELTA against the model's steps "
          "between the latching clocks (reads with no step within 4 clocks of a latch); "
-         "*unmatched* = SNAP_EDGE_TIME values matching no model edge.", ""]
+         "*unmatched* = SNAP_EDGE_TIME values matching no model edge. (The latch instant is known "
+         "only through SNAP_TIME, so M's added error is 0 by construction; what tests M is the "
+         "SNAP_DELTA check, i.e. that count and time are latched in the same clock.)", ""]
     if errors:
         L += [f"**Simulation errors**: {'; '.join(errors.values())}", ""]
     L += ["| unit | rpm | edges | reads | M/T added max (%) | T added max (%) | M added max (%) "
