@@ -57,9 +57,13 @@ def param_values(name: str) -> tuple[list[int], list[int]]:
     raise ValueError(f"enc_ip.core: parameter {name} has no '(range ..)' or '(values ..)'")
 
 
-def module_params(path: Path) -> list[str]:
-    """The parameters a Verilog file declares (``parameter integer NAME``)."""
-    return re.findall(r"parameter\s+integer\s+(\w+)", Path(path).read_text())
+def module_params(path: Path, guarded_only: bool = False) -> list[str]:
+    """The parameters a Verilog file declares (``parameter integer NAME``). With
+    ``guarded_only``, leave out those whose declaration says "(checked by <parent>)": internal
+    submodules whose range the instantiating module guards."""
+    decls = re.findall(r"parameter\s+integer\s+(\w+)[^\n]*", Path(path).read_text())
+    lines = re.findall(r"parameter\s+integer\s+\w+[^\n]*", Path(path).read_text())
+    return [n for n, line in zip(decls, lines) if not (guarded_only and "checked by" in line)]
 
 
 def ranged_params() -> list[str]:
@@ -82,7 +86,7 @@ def guard_cases(files: list[str] | None = None):
     corners (ok) and the values just outside (not ok), for the parameter-guard tests."""
     for f in files or (rtl_files() + board_files()):
         module = Path(f).stem
-        for p in module_params(TOP / f):
+        for p in module_params(TOP / f, guarded_only=True):
             if p in core()["parameters"]:
                 good, bad = param_values(p)
                 for v in good:
