@@ -1,0 +1,105 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The count-rate rule through the peripheral: enc_qei (FUNC x4) read over its bus.
+
+With CTRL.FILTER_LEN = F (set at run time, one build for every F), random walks whose states last
+uniform [S, 2S] clocks must count exactly at S = 1.05 x max(1, F/2) (the contract's bound, see
+test_count_rate.py), with QERR never set (GLITCH may fire there: a reversal after a short state is a
+level of one channel shorter than the filter, rejected without a loss); below the bound every walk is exact or
+has QERR/GLITCH set: never a silent loss. COUNT is read as COUNT_LO then COUNT_HI over
+Wishbone (enc_qei_wb) or AXI4-Lite with random back-pressure (enc_qei_axil), through the bus
+models of tb/enc_qei/qei_tb.py. The `sweep` test is the benchmark driver of scripts/count_rate.py.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+
+import cocotb
+from cocotb.triggers import ClockCycles
+
+from cocotbext.quadrature import QuadratureDriver
+from hedsmodel.waveform import random_walk
+from qei_tb import PERIOD_PS, T_NS, QeiBus, pack
+from tbutil import start
+
+
+class Qei:
+    def __init__(self, dut, rng):
+        self.dut = dut
+        self.bus = QeiBus(dut, rng)
+        self.mask = (1 << int(dut.COUNT_W.value)) - 1
+        self.drv = QuadratureDriver(dut.a_in, dut.b_in, clock_period_ps=PERIOD_PS)
+        self.pos = 0  # 4X position of the stimulus now (state 00 at reset)
+
+    async def walk(self, f: int, s_clocks: float, n: int, rng: random.Random,
+                   p_reverse: float = 0.3) -> dict:
+        """Set FILTER_LEN = f, zero the count, play n transitions; return the verdict."""
+        bus = self.bus
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", RANGE="free", FILTER_LEN=f))
+        await ClockCycles(self.dut.clk, f + 6)
+        await bus.set_count(0)
+        await bus.events()  # clear
+        start_pos = self.pos
+        wf = random_walk(rng, n, s_clocks * T_NS, 2 * s_clocks * T_NS, p_reverse=p_reverse,
+                         start_pos=start_pos)
+        await self.drv.play(wf)
+        self.pos = wf.final_position
+        await ClockCycles(self.dut.clk, f + 8)
+        count = await bus.count()
+        events = await bus.events()
+        want = (wf.final_position - start_pos) & self.mask
+        r = {"f": f, "s": s_clocks, "n": n, "count": count, "want": want,
+             "exact": count == want, "qerr": "QERR" in events, "glitch": "GLITCH" in events,
+             "min_state_clocks": wf.min_state_ns() / T_NS}
+        r["flagged"] = r["qerr"] or r["glitch"]
+        return r
+
+
+async def begin(dut) -> tuple[Qei, random.Random]:
+    rng = await start(dut, PERIOD_PS, inputs={"a_in": 0, "b_in": 0, "z_in": 0, "probe_in": 0,
+                                               "snap_in": 0})
+    await ClockCycles(dut.clk, 30)
+    return Qei(dut, rng), rng
+
+
+def bound_clocks(f: int) -> float:
+    return max(1.0, f / 2)
+
+
+@cocotb.test()
+async def exact_at_bound(dut):
+    """F = 1..4 at run time: 8,000 transitions each at S = 1.05 x max(1, F/2), exact, no QERR."""
+    qei, rng = await begin(dut)
+    for f in (1, 2, 3, 4):
+        r = await qei.walk(f, 1.05 * bound_clocks(f), 8000, rng)
+        dut._log.info("F=%d S=%.3f: %s", f, r["s"], r)
+        assert r["exact"], f"miscount through the bus at the contract's bound: {r}"
+        assert not r["qerr"], f"QERR at the contract's bound: {r}"
+
+
+@cocotb.test()
+async def never_silent(dut):
+    """Past the bound (F = 3: levels shorter than the filter; states under one clock): every walk
+    exact or flagged, and states under one clock always flagged."""
+    qei, rng = await begin(dut)
+    for f, s in ((3, 1.05), (1, 0.7), (2, 0.4)):
+        r = await qei.walk(f, s, 2000, rng)
+        dut._log.info("F=%d S=%.2f: %s", f, s, r)
+        assert r["exact"] or r["flagged"], f"silent miscount through the bus: {r}"
+        if s < 1:
+            assert r["flagged"], f"states under one clock but neither QERR nor GLITCH: {r}"
+
+
+@cocotb.test()
+async def sweep(dut):
+    """Benchmark driver (scripts/count_rate.py --dut qei): points from ENC_POINTS."""
+    qei, _ = await begin(dut)
+    results = []
+    for pt in json.loads(os.environ["ENC_POINTS"]):
+        r = await qei.walk(pt["f"], pt["s"], pt["n"], random.Random(pt["seed"]))
+        r["seed"] = pt["seed"]
+        results.append(r)
+        with open(os.environ["ENC_RESULTS"], "w") as fh:
+            json.dump(results, fh)

@@ -1,0 +1,11 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The count-rate rule through enc_qei's bus adapters (cocotb tests in qei_count_rate.py)."""
+
+import pytest
+
+from harness import run
+
+
+@pytest.mark.parametrize("top", ["enc_qei_wb", "enc_qei_axil"])
+def test_count_rate_qei(top):
+    run(top, "qei_count_rate", name=f"count_rate_{top}", testcase="exact_at_bound,never_silent")
