@@ -615,11 +615,20 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
             last_edge[i], jsel[i] = sel[j], j
         else:
             unmatched += 1
+    # PERIOD is a live register read a few clocks after the snapshot: it may already hold the
+    # measurement ended by the next selected edge. Take the pair (j-1, j) or (j, j+1) it fits.
     p_from = np.full(len(reads), -1, np.int64)
     p_to = np.full(len(reads), -1, np.int64)
-    ok = jsel >= 1
-    p_to[ok] = sel[jsel[ok]]
-    p_from[ok] = sel[jsel[ok] - 1]
+    period_newer = 0
+    for i in np.flatnonzero(jsel >= 1):
+        j = int(jsel[i])
+        p_from[i], p_to[i] = sel[j - 1], sel[j]
+        if j + 1 < sel.size:
+            fits = abs(reads[i]["PERIOD"] - (et.t_s[sel[j]] - et.t_s[sel[j - 1]]) / tick) <= 2
+            fits_next = abs(reads[i]["PERIOD"] - (et.t_s[sel[j + 1]] - et.t_s[sel[j]]) / tick) <= 2
+            if fits_next and not fits and et.t_s[sel[j + 1]] < t_read[i] + 2e-6:
+                p_from[i], p_to[i] = sel[j], sel[j + 1]
+                period_newer += 1
     snaps = []
     for r in reads:
         pc = r["PERIOD_CTRL"]
@@ -645,7 +654,7 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
             checked["edge_delta"] += 1
             want = int(et.pos[last_edge[i]] - et.pos[last_edge[i - 1]])
             bad_edge_delta += snaps[i].edge_delta != want
-        if jsel[i] >= 1:
+        if p_to[i] >= 0:
             checked["period"] += 1
             want_p = (et.t_s[p_to[i]] - et.t_s[p_from[i]]) / tick
             bad_period += abs(snaps[i].period - want_p) > 2
@@ -665,7 +674,8 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
     res = {"unit": case["unit"], "rpm": case["rpm"], "edge": edge, "reads": len(reads),
            "kind": case["kind"],
            "unmatched": unmatched, "bad_edge_delta": bad_edge_delta, "bad_period": bad_period,
-           "bad_delta": bad_delta, "checked": checked, "latency_ticks": med, "methods": {}}
+           "bad_delta": bad_delta, "checked": checked, "latency_ticks": med,
+           "period_newer": period_newer, "methods": {}}
     if case["kind"] == "stop":
         t_stop = max(pc.tb for pc in build_profile(case["profile"]).pieces())
         stalled = np.array([sn.stalled for sn in snaps], bool)
@@ -711,14 +721,19 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
          "SNAP_EDGE_DELTA against the model's count between the matched edges, PERIOD against "
          "the model's time between them (±2 ticks), SNAP_DELTA against the model's steps "
          "between the latching clocks (reads with no step within 4 clocks of a latch); "
-         "*unmatched* = SNAP_EDGE_TIME values matching no model edge. (The latch instant is known "
+         "*unmatched* = SNAP_EDGE_TIME values matching no model edge; *edge latency* = median "
+         "SNAP_EDGE_TIME minus the pin time of its edge (the contract's FILTER_LEN + 3 = "
+         f"{FILTER_LEN + 3} clocks, plus the sampling's half clock); *PERIOD newer* = reads where "
+         "PERIOD (live, read a few clocks after the snapshot) already held the next edge's "
+         "measurement, which the floor then uses too. (The latch instant is known "
          "only through SNAP_TIME, so M's added error is 0 by construction; what tests M is the "
          "SNAP_DELTA check, i.e. that count and time are latched in the same clock.)", ""]
     if errors:
         L += [f"**Simulation errors**: {'; '.join(errors.values())}", ""]
     L += ["| unit | rpm | edges | reads | M/T added max (%) | T added max (%) | M added max (%) "
           "| M/T error max (%) | zeros M/T | checks failed (edge Δ / period / Δ of checked) "
-          "| unmatched |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|"]
+          "| unmatched | edge latency (ticks) | PERIOD newer |",
+          "|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|"]
     points = []
     stops = [r for r in results if r["kind"] == "stop"]
     results = [r for r in results if r["kind"] != "stop"]
@@ -732,7 +747,8 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
                  f"{fmt_pct(t.get('added_max'), 4)} | {fmt_pct(mm.get('added_max'), 4)} | "
                  f"{fmt_pct(mt.get('err_max'), 3)} | {mt.get('zeros', 0)} | "
                  f"{r['bad_edge_delta']}/{ck['edge_delta']}, {r['bad_period']}/{ck['period']}, "
-                 f"{r['bad_delta']}/{ck['delta']} | {r['unmatched']} |")
+                 f"{r['bad_delta']}/{ck['delta']} | {r['unmatched']} | "
+                 f"{r['latency_ticks']:.1f} | {r['period_newer']} |")
         if r["edge"] == "a_rising" and mt.get("n"):
             points.append({"rpm": r["rpm"], "unit": r["unit"], "added_max": mt["added_max"]})
     L.append("")
