@@ -6,7 +6,7 @@
 //   a_in, b_in  -> enc_conditioner_rt (CTRL.FILTER_LEN) --+
 //   z_in, probe_in -> enc_conditioner_rt (same length) ---+-> enc_qei_core (decode, count, range,
 //                                                         |   index, probe, compare)
-//                                      enc_qei_timing ----+   timebase (TB_PRESCALE)
+//                                      enc_qei_timing ----+   timebase, snapshots, period, stall
 //   req/resp <-> enc_qei_regs (generated from rtl/enc_qei.rdl) <-> configuration, state, events
 //
 // Z and probe_in go through their own synchronizer and filter of the same length as A and B, so
@@ -33,9 +33,7 @@ module enc_qei #(
     input  wire        b_in,        // encoder channel B, asynchronous
     input  wire        z_in,        // index channel, asynchronous
     input  wire        probe_in,    // external latch input, asynchronous
-    // verilator lint_off UNUSEDSIGNAL
     input  wire        snap_in,     // synchronous snapshot strobe
-    // verilator lint_on UNUSEDSIGNAL
     output wire        irq,         // any enabled pending event
     output wire        cmp_out      // one-clock pulse on a compare match
 );
@@ -91,13 +89,12 @@ module enc_qei #(
   wire [11:0] events, irq_en;
   wire [15:0] qerr_count_unused, glitch_count_unused;
   wire [15:0] tb_prescale;
-  // verilator lint_off UNUSEDSIGNAL
-  // (timing-unit configuration: snapshots, period capture and stall detection come next)
   wire        snap_cmd, snap_in_en, snap_period_en, snap_edge;
-  wire [31:0] snap_period, stall_timeout;
+  // verilator lint_off UNUSEDSIGNAL
+  wire [31:0] snap_period, stall_timeout;  // (bits TS_W and up are always 0)
+  // verilator lint_on UNUSEDSIGNAL
   wire        period_en, period_edge;
   wire [7:0]  period_n;
-  // verilator lint_on UNUSEDSIGNAL
 
   // ---- conditioners -------------------------------------------------------------------------------
   wire a_c, b_c, z_c, probe_c, glitch_ab, valid_ab, glitch_zp_unused, valid_zp_unused;
@@ -130,26 +127,12 @@ module enc_qei #(
       .valid     (valid_zp_unused)
   );
 
-  // ---- timing -----------------------------------------------------------------------------------------
-  wire [TS_W-1:0] timebase;
-  wire            tick_unused;
-
-  enc_qei_timing #(
-      .TS_W(TS_W)
-  ) u_timing (
-      .clk     (clk),
-      .rst     (rst),
-      .prescale(tb_prescale),
-      .timebase(timebase),
-      .tick    (tick_unused)
-  );
-
   // ---- core ---------------------------------------------------------------------------------------------
-  wire [COUNT_W-1:0] count_unused, idx_latch, probe_latch;
+  wire [COUNT_W-1:0] count_unused, count_next, idx_latch, probe_latch;
   wire [TS_W-1:0]    probe_time;
+  wire [TS_W-1:0]    timebase;
   wire a_eff, b_eff, z_eff, dir, idx_armed, stopped, idx_disarm, probe_disarm;
-  wire step_up_unused, step_dn_unused, applied_up_unused, applied_dn_unused;
-  wire edge_any_unused, edge_a_rise_unused;
+  wire step_up, step_dn, applied_up, applied_dn, edge_any, edge_a_rise;
   wire ev_overflow, ev_underflow, ev_index, ev_probe, ev_cmp, ev_qerr, ev_dir_change;
 
   enc_qei_core #(
@@ -192,6 +175,7 @@ module enc_qei #(
       .count_lo_rdata(count_lo_rdata),
       .count_hi_rdata(count_hi_rdata),
       .count         (count_unused),
+      .count_next    (count_next),
       .idx_latch     (idx_latch),
       .probe_latch   (probe_latch),
       .probe_time    (probe_time),
@@ -203,12 +187,12 @@ module enc_qei #(
       .stopped       (stopped),
       .idx_disarm    (idx_disarm),
       .probe_disarm  (probe_disarm),
-      .step_up       (step_up_unused),
-      .step_dn       (step_dn_unused),
-      .applied_up    (applied_up_unused),
-      .applied_dn    (applied_dn_unused),
-      .edge_any      (edge_any_unused),
-      .edge_a_rise   (edge_a_rise_unused),
+      .step_up       (step_up),
+      .step_dn       (step_dn),
+      .applied_up    (applied_up),
+      .applied_dn    (applied_dn),
+      .edge_any      (edge_any),
+      .edge_a_rise   (edge_a_rise),
       .ev_overflow   (ev_overflow),
       .ev_underflow  (ev_underflow),
       .ev_index      (ev_index),
@@ -217,6 +201,53 @@ module enc_qei #(
       .ev_qerr       (ev_qerr),
       .ev_dir_change (ev_dir_change),
       .cmp_out       (cmp_out)
+  );
+
+  // ---- timing: timebase, snapshots, period capture, stall ------------------------------------------
+  wire [COUNT_W-1:0] snap_count;
+  wire [TS_W-1:0]    snap_time, snap_edge_time, period;
+  wire [31:0]        snap_delta, snap_edge_delta;
+  wire               period_ovf_flag, period_dir_flag, stalled;
+  wire               ev_snap, ev_period, ev_period_ovf, ev_stall;
+
+  enc_qei_timing #(
+      .COUNT_W(COUNT_W),
+      .TS_W   (TS_W)
+  ) u_timing (
+      .clk            (clk),
+      .rst            (rst),
+      .prescale       (tb_prescale),
+      .edge_any       (edge_any),
+      .edge_a_rise    (edge_a_rise),
+      .step           (step_up | step_dn),
+      .applied_up     (applied_up),
+      .applied_dn     (applied_dn),
+      .dir_change     (ev_dir_change),
+      .count_next     (count_next),
+      .snap_cmd       (snap_cmd),
+      .snap_in        (snap_in),
+      .snap_in_en     (snap_in_en),
+      .snap_period_en (snap_period_en),
+      .snap_edge      (snap_edge),
+      .snap_period    (snap_period[TS_W-1:0]),
+      .period_en      (period_en),
+      .period_edge    (period_edge),
+      .period_n       (period_n),
+      .stall_timeout  (stall_timeout[TS_W-1:0]),
+      .timebase       (timebase),
+      .snap_count     (snap_count),
+      .snap_time      (snap_time),
+      .snap_edge_time (snap_edge_time),
+      .snap_delta     (snap_delta),
+      .snap_edge_delta(snap_edge_delta),
+      .period         (period),
+      .period_ovf_flag(period_ovf_flag),
+      .period_dir_flag(period_dir_flag),
+      .stalled        (stalled),
+      .ev_snap        (ev_snap),
+      .ev_period      (ev_period),
+      .ev_period_ovf  (ev_period_ovf),
+      .ev_stall       (ev_stall)
   );
 
   // verilator lint_off UNUSEDSIGNAL
@@ -233,6 +264,7 @@ module enc_qei #(
 
   wire [63:0] idx_latch64   = zext_count(idx_latch);
   wire [63:0] probe_latch64 = zext_count(probe_latch);
+  wire [63:0] snap_count64  = zext_count(snap_count);
 
   // ---- register block -------------------------------------------------------------------------------
   enc_qei_regs #(
@@ -253,7 +285,7 @@ module enc_qei #(
       .caps_ts_w              (TS_W8),
       .caps_index             (1'b1),
       .caps_probe             (1'b1),
-      .caps_timing            (1'b0),
+      .caps_timing            (1'b1),
       .ctrl_en                (ctrl_en),
       .ctrl_swap_ab           (ctrl_swap_ab),
       .ctrl_inv_a             (ctrl_inv_a),
@@ -267,7 +299,7 @@ module enc_qei #(
       .status_z               (z_eff),
       .status_dir             (dir),
       .status_index_armed     (idx_armed),
-      .status_stalled         (1'b0),
+      .status_stalled         (stalled),
       .status_stopped         (stopped),
       .status_valid           (valid_ab),
       .count_lo_rdata         (count_lo_rdata),
@@ -318,13 +350,13 @@ module enc_qei #(
       .events_dir_change      (events[7]),
       .events_dir_change_set  (ev_dir_change),
       .events_stall           (events[8]),
-      .events_stall_set       (1'b0),
+      .events_stall_set       (ev_stall),
       .events_snap_ready      (events[9]),
-      .events_snap_ready_set  (1'b0),
+      .events_snap_ready_set  (ev_snap),
       .events_period_ready    (events[10]),
-      .events_period_ready_set(1'b0),
+      .events_period_ready_set(ev_period),
       .events_period_ovf      (events[11]),
-      .events_period_ovf_set  (1'b0),
+      .events_period_ovf_set  (ev_period_ovf),
       .irq_en_en              (irq_en),
       .qerr_count_value       (qerr_count_unused),
       .qerr_count_value_incr  (ev_qerr),
@@ -337,18 +369,18 @@ module enc_qei #(
       .snap_ctrl_period_en    (snap_period_en),
       .snap_ctrl_edge         (snap_edge),
       .snap_period_value      (snap_period),
-      .snap_count_lo_value    (32'd0),
-      .snap_count_hi_value    (32'd0),
-      .snap_time_value        (32'd0),
-      .snap_edge_time_value   (32'd0),
-      .snap_delta_value       (32'd0),
-      .snap_edge_delta_value  (32'd0),
+      .snap_count_lo_value    (snap_count64[31:0]),
+      .snap_count_hi_value    (snap_count64[63:32]),
+      .snap_time_value        (zext_ts(snap_time)),
+      .snap_edge_time_value   (zext_ts(snap_edge_time)),
+      .snap_delta_value       (snap_delta),
+      .snap_edge_delta_value  (snap_edge_delta),
       .period_ctrl_en         (period_en),
       .period_ctrl_edge       (period_edge),
       .period_ctrl_n          (period_n),
-      .period_ctrl_overflow   (1'b0),
-      .period_ctrl_dir_change (1'b0),
-      .period_value           (32'd0),
+      .period_ctrl_overflow   (period_ovf_flag),
+      .period_ctrl_dir_change (period_dir_flag),
+      .period_value           (zext_ts(period)),
       .stall_timeout_value    (stall_timeout)
   );
 

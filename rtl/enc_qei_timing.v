@@ -1,43 +1,266 @@
 // SPDX-License-Identifier: Apache-2.0
-// enc_qei_timing -- the timing unit of enc_qei: the timebase with its prescaler.
+// enc_qei_timing -- the timing unit of enc_qei: timebase, snapshots, period capture and stall
+// detection (the velocity side of the peripheral: unit-time M, period T and timestamp M/T).
 //
-// TIMEBASE is a free-running TS_W-bit counter that advances once every PRESCALE + 1 clocks and
-// wraps. A write of TB_PRESCALE restarts the prescaler's clock count.
+// Timebase: TS_W bits, +1 every PRESCALE + 1 clocks (`tick`), wrapping; a change of PRESCALE
+// restarts the prescaler. Every time below is in its ticks, and an edge's timestamp is the
+// timebase value in the clock the core reports the edge (the same clock the count takes it).
+// Snapshot: a request -- snap_cmd, a rising edge of snap_in while snap_in_en, or the unit timer
+// (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in that one clock:
+//   SNAP_COUNT      the count after this clock (count_next)
+//   SNAP_TIME       the timebase now
+//   SNAP_EDGE_TIME  the timestamp of the last edge of the selected type (this clock's included)
+//   SNAP_DELTA      the applied count steps since the previous snapshot (this clock's included)
+//   SNAP_EDGE_DELTA the applied steps between the previous snapshot's last selected edge and this
+//                   one's: prev_tail + delta - tail, where tail counts the steps after the last
+//                   selected edge (the step of an edge's own clock belongs before it)
+// Period: while period_en, every period_n (0 acts as 1) selected edges the ticks since the edge
+// that started the measurement go to PERIOD (timebase(end) - timebase(start)); the end edge starts
+// the next one. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
+// event when it saturates); the direction-change flag is set by a count step against the
+// previous one inside the measurement (the start edge's own excluded, the end edge's included).
+// Stall: no count step of the count function for stall_timeout ticks (0: off) raises the stall
+// event once and sets `stalled` until the next step.
 `default_nettype none
 
 module enc_qei_timing #(
-    parameter integer TS_W = 32  // timebase width, 16 .. 32 (checked by enc_qei)
+    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)
+    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)
 ) (
-    input  wire            clk,
-    input  wire            rst,           // synchronous, active high
-    input  wire [15:0]     prescale,      // TB_PRESCALE.PRESCALE
-    output wire [TS_W-1:0] timebase,
-    output wire            tick           // the timebase advances at this clock edge
+    input  wire               clk,
+    input  wire               rst,             // synchronous, active high
+    input  wire [15:0]        prescale,        // TB_PRESCALE.PRESCALE
+    // from the core, in the clock of the edge / step
+    input  wire               edge_any,        // a valid quadrature transition
+    input  wire               edge_a_rise,     // a rising edge of A
+    input  wire               step,            // a step of the count function (applied or not)
+    input  wire               applied_up,      // the count took a +1 step
+    input  wire               applied_dn,      // the count took a -1 step
+    input  wire               dir_change,      // a step against the previous step's direction
+    input  wire [COUNT_W-1:0] count_next,      // the count after this clock
+    // snapshot (SNAP_CTRL, SNAP_PERIOD)
+    input  wire               snap_cmd,
+    input  wire               snap_in,
+    input  wire               snap_in_en,
+    input  wire               snap_period_en,
+    input  wire               snap_edge,       // 0 any edge, 1 A rising
+    input  wire [TS_W-1:0]    snap_period,
+    // period (PERIOD_CTRL)
+    input  wire               period_en,
+    input  wire               period_edge,     // 0 any edge, 1 A rising
+    input  wire [7:0]         period_n,
+    // stall
+    input  wire [TS_W-1:0]    stall_timeout,
+    // outputs
+    output wire [TS_W-1:0]    timebase,
+    output wire [COUNT_W-1:0] snap_count,
+    output wire [TS_W-1:0]    snap_time,
+    output wire [TS_W-1:0]    snap_edge_time,
+    output wire [31:0]        snap_delta,
+    output wire [31:0]        snap_edge_delta,
+    output wire [TS_W-1:0]    period,
+    output wire               period_ovf_flag,
+    output wire               period_dir_flag,
+    output wire               stalled,
+    output wire               ev_snap,
+    output wire               ev_period,
+    output wire               ev_period_ovf,
+    output wire               ev_stall
 );
 
+  localparam [TS_W-1:0] TS_ONE  = {{(TS_W-1){1'b0}}, 1'b1};
+  localparam [TS_W-1:0] TS_ZERO = {TS_W{1'b0}};
+  localparam [TS_W-1:0] TS_MAX  = {TS_W{1'b1}};
+  localparam signed [33:0] SAT_HI = 34'sh0_7FFF_FFFF;
+  localparam signed [33:0] SAT_LO = -34'sh0_7FFF_FFFF;
+
+  // 34-bit signed to 32-bit, saturating at +/-(2^31 - 1) (the top bits of c are the sign only)
+  // verilator lint_off UNUSEDSIGNAL
+  function [31:0] sat32;
+    input signed [33:0] v;
+    reg   signed [33:0] c;
+    begin
+      c     = (v > SAT_HI) ? SAT_HI : (v < SAT_LO) ? SAT_LO : v;
+      sat32 = c[31:0];
+    end
+  endfunction
+  // verilator lint_on UNUSEDSIGNAL
+
+  // ---- timebase ----------------------------------------------------------------------------------
   reg [15:0]     pre_q;
   reg [15:0]     prescale_q;  // last clock's PRESCALE: a change restarts the prescaler
   reg [TS_W-1:0] tb_q;
 
   wire restart = (prescale != prescale_q);
-  wire tick_d  = ~restart & (pre_q >= prescale);
+  wire tick    = ~restart & (pre_q >= prescale);
 
   always @(posedge clk) begin
     if (rst) begin
       pre_q      <= 16'd0;
       prescale_q <= 16'd0;
-      tb_q       <= {TS_W{1'b0}};
+      tb_q       <= TS_ZERO;
     end else begin
       prescale_q <= prescale;
-      pre_q      <= (restart | tick_d) ? 16'd0 : pre_q + 16'd1;
-      if (tick_d) begin
-        tb_q <= tb_q + {{(TS_W-1){1'b0}}, 1'b1};
+      pre_q      <= (restart | tick) ? 16'd0 : pre_q + 16'd1;
+      if (tick) begin
+        tb_q <= tb_q + TS_ONE;
       end
     end
   end
 
-  assign timebase = tb_q;
-  assign tick     = tick_d;
+  // ---- snapshot ------------------------------------------------------------------------------------
+  reg  [TS_W-1:0] unit_q;        // ticks since the unit timer started
+  reg             snap_in_q;
+  wire [TS_W-1:0] unit_len = (snap_period == TS_ZERO) ? TS_ONE : snap_period;
+  wire            unit_hit = snap_period_en & tick & ((unit_q + TS_ONE) >= unit_len);
+  wire            snap_req = snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      unit_q    <= TS_ZERO;
+      snap_in_q <= 1'b0;
+    end else begin
+      snap_in_q <= snap_in;
+      if (~snap_period_en | unit_hit) begin
+        unit_q <= TS_ZERO;
+      end else if (tick) begin
+        unit_q <= unit_q + TS_ONE;
+      end
+    end
+  end
+
+  wire               sel_snap = snap_edge ? edge_a_rise : edge_any;
+  wire signed [33:0] s_now    = applied_up ? 34'sd1 : applied_dn ? -34'sd1 : 34'sd0;
+  reg  signed [33:0] delta_q;     // applied steps since the previous snapshot
+  reg  signed [33:0] tail_q;      // applied steps since the last selected edge
+  reg  signed [33:0] prev_tail_q; // tail at the previous snapshot
+  reg  [TS_W-1:0]    last_edge_q; // timestamp of the last selected edge
+  wire signed [33:0] delta_now = delta_q + s_now;
+  wire signed [33:0] tail_now  = sel_snap ? 34'sd0 : tail_q + s_now;
+  wire [TS_W-1:0]    edge_now  = sel_snap ? tb_q : last_edge_q;
+  // accumulators saturate well inside 34 bits
+  wire signed [33:0] delta_sat = (delta_now > SAT_HI) ? SAT_HI : (delta_now < SAT_LO) ? SAT_LO : delta_now;
+  wire signed [33:0] tail_sat  = (tail_now > SAT_HI) ? SAT_HI : (tail_now < SAT_LO) ? SAT_LO : tail_now;
+
+  reg [COUNT_W-1:0] snap_count_q;
+  reg [TS_W-1:0]    snap_time_q;
+  reg [TS_W-1:0]    snap_edge_time_q;
+  reg [31:0]        snap_delta_q;
+  reg [31:0]        snap_edge_delta_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      delta_q           <= 34'sd0;
+      tail_q            <= 34'sd0;
+      prev_tail_q       <= 34'sd0;
+      last_edge_q       <= TS_ZERO;
+      snap_count_q      <= {COUNT_W{1'b0}};
+      snap_time_q       <= TS_ZERO;
+      snap_edge_time_q  <= TS_ZERO;
+      snap_delta_q      <= 32'd0;
+      snap_edge_delta_q <= 32'd0;
+    end else begin
+      tail_q      <= tail_sat;
+      last_edge_q <= edge_now;
+      if (snap_req) begin
+        delta_q           <= 34'sd0;
+        prev_tail_q       <= tail_sat;
+        snap_count_q      <= count_next;
+        snap_time_q       <= tb_q;
+        snap_edge_time_q  <= edge_now;
+        snap_delta_q      <= sat32(delta_sat);
+        snap_edge_delta_q <= sat32(prev_tail_q + delta_sat - tail_sat);
+      end else begin
+        delta_q <= delta_sat;
+      end
+    end
+  end
+
+  // ---- period ---------------------------------------------------------------------------------------
+  wire       sel_per  = period_edge ? edge_a_rise : edge_any;
+  wire [7:0] per_last = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
+  reg        started_q, ovf_q, dir_q;
+  reg [7:0]  n_q;
+  reg [TS_W-1:0] ticks_q;
+  reg [TS_W-1:0] period_q;
+  reg        period_ovf_q, period_dir_q;
+
+  wire capture  = period_en & started_q & sel_per & (n_q == per_last);
+  wire saturate = period_en & started_q & ~(sel_per & (n_q == per_last)) & tick & (ticks_q == TS_MAX);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      started_q    <= 1'b0;
+      ovf_q        <= 1'b0;
+      dir_q        <= 1'b0;
+      n_q          <= 8'd0;
+      ticks_q      <= TS_ZERO;
+      period_q     <= TS_ZERO;
+      period_ovf_q <= 1'b0;
+      period_dir_q <= 1'b0;
+    end else if (!period_en) begin
+      started_q <= 1'b0;
+    end else if (sel_per & (~started_q | capture)) begin
+      // a start edge (the first, or the end edge of the last measurement)
+      started_q <= 1'b1;
+      ovf_q     <= 1'b0;
+      dir_q     <= 1'b0;
+      n_q       <= 8'd0;
+      ticks_q   <= tick ? TS_ONE : TS_ZERO;
+      if (capture) begin
+        period_q     <= ovf_q ? TS_MAX : ticks_q;
+        period_ovf_q <= ovf_q;
+        period_dir_q <= dir_q | dir_change;
+      end
+    end else if (started_q) begin
+      if (sel_per) begin
+        n_q <= n_q + 8'd1;
+      end
+      dir_q <= dir_q | dir_change;
+      if (tick) begin
+        if (ticks_q == TS_MAX) begin
+          ovf_q <= 1'b1;
+        end else begin
+          ticks_q <= ticks_q + TS_ONE;
+        end
+      end
+    end
+  end
+
+  // ---- stall ----------------------------------------------------------------------------------------
+  reg [TS_W-1:0] stall_q;
+  reg            stalled_q;
+  wire           stall_hit = (stall_timeout != TS_ZERO) & ~stalled_q & ~step & tick &
+                             ((stall_q + TS_ONE) >= stall_timeout);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      stall_q   <= TS_ZERO;
+      stalled_q <= 1'b0;
+    end else if (step | (stall_timeout == TS_ZERO)) begin
+      stall_q   <= TS_ZERO;
+      stalled_q <= 1'b0;
+    end else if (tick & ~stalled_q) begin
+      stall_q   <= stall_q + TS_ONE;
+      stalled_q <= stall_hit;
+    end
+  end
+
+  // ---- outputs -----------------------------------------------------------------------------------------
+  assign timebase        = tb_q;
+  assign snap_count      = snap_count_q;
+  assign snap_time       = snap_time_q;
+  assign snap_edge_time  = snap_edge_time_q;
+  assign snap_delta      = snap_delta_q;
+  assign snap_edge_delta = snap_edge_delta_q;
+  assign period          = period_q;
+  assign period_ovf_flag = period_ovf_q;
+  assign period_dir_flag = period_dir_q;
+  assign stalled         = stalled_q;
+  assign ev_snap         = snap_req;
+  assign ev_period       = capture;
+  assign ev_period_ovf   = saturate & ~ovf_q;
+  assign ev_stall        = stall_hit;
 
 endmodule
 

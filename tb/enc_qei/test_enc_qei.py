@@ -648,6 +648,294 @@ async def register_walk(dut):
     await bus.events()
 
 
+# ---- timing unit (issue 13) ----------------------------------------------------------------------------
+class ClockTrace:
+    """Per clock (sampled after each rising edge): the count, the timebase and the decoder's edge
+    pulses of the core, read from the design's registers. It says what happened in each clock, so
+    a snapshot's values can be checked to come from one and the same clock."""
+
+    def __init__(self, dut):
+        core, timing = dut.u_qei.u_core, dut.u_qei.u_timing
+        self.sig = (core.count_q, timing.tb_q, core.edge_any, core.edge_a_rise)
+        self.count, self.tb, self.any, self.arise = [], [], [], []
+        self.task = cocotb.start_soon(self._run(dut))
+
+    async def _run(self, dut):
+        from cocotb.triggers import ReadOnly
+        while True:
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            c, t, e, r = (int(x.value) for x in self.sig)
+            self.count.append(c)
+            self.tb.append(t)
+            self.any.append(e)
+            self.arise.append(r)
+
+    def clock_of(self, tb_value: int, after: int = 0) -> int:
+        """The clock index whose timebase is tb_value (prescaler 0: one clock per value)."""
+        for i in range(after, len(self.tb)):
+            if self.tb[i] == tb_value:
+                return i
+        raise AssertionError(f"no clock with timebase {tb_value}")
+
+    def last_edge_time(self, i: int, a_rising: bool) -> int | None:
+        edges = self.arise if a_rising else self.any
+        for j in range(i, -1, -1):
+            if edges[j]:
+                return self.tb[j]
+        return None
+
+
+async def read_snapshot(bus):
+    return {n: await bus.rd(r) for n, r in (
+        ("count", "SNAP_COUNT_LO"), ("count_hi", "SNAP_COUNT_HI"), ("time", "SNAP_TIME"),
+        ("edge_time", "SNAP_EDGE_TIME"), ("delta", "SNAP_DELTA"), ("edge_delta", "SNAP_EDGE_DELTA"))}
+
+
+def s32(v):
+    return v - (1 << 32) if v >> 31 else v
+
+
+@cocotb.test()
+async def snapshot_coherence(dut):
+    """Snapshots by bus command, snap_in and the unit timer while the shaft turns: SNAP_COUNT,
+    SNAP_TIME, SNAP_EDGE_TIME and SNAP_DELTA all belong to one clock."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=1000, filter_len=1)
+    trace = ClockTrace(dut)
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    snaps = []
+    switched = {}  # edge type -> trace clock of the switch to it
+    for edge in ("any", "a_rising"):
+        switched[edge] = len(trace.tb)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        await bus.wr("SNAP_PERIOD", rng.randint(60, 90))
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        wf = random_walk(rng, 300, 2.2 * T_NS, 6 * T_NS, p_reverse=0.15, start_pos=env.pos)
+        task = cocotb.start_soon(env.drv.play(wf))
+        while not task.done():
+            how = rng.choice(["cmd", "in", "wait"])
+            if how == "cmd":
+                await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, IN_EN=1, PERIOD_EN=1, EDGE=edge))
+            elif how == "in":
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 1
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 0
+            else:
+                await ClockCycles(dut.clk, rng.randint(5, 40))
+            # the unit timer keeps snapping; read whatever is latched now, coherently or not
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=0, PERIOD_EN=0, EDGE=edge))
+            snaps.append((edge, await read_snapshot(bus)))
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        await task
+        env.pos = wf.positions[-1]
+    await env.settle()
+    assert len(snaps) >= 20
+    prev_i = None
+    for edge, s in snaps:
+        i = trace.clock_of(s["time"], after=0 if prev_i is None else max(prev_i - 5, 0))
+        count = (s["count_hi"] << 32 | s["count"]) & model.max
+        assert count == trace.count[i + 1], f"SNAP_COUNT {count} is not the count of clock {i}"
+        exp_edge = trace.last_edge_time(i, edge == "a_rising")
+        edges = trace.arise if edge == "a_rising" else trace.any
+        if not any(edges[switched[edge] + 2:i + 1]):
+            exp_edge = None  # no edge of the new type since EDGE changed: not defined yet
+        if exp_edge is not None:
+            assert s["edge_time"] == exp_edge & ts_mask, \
+                f"SNAP_EDGE_TIME {s['edge_time']}, last {edge} edge at {exp_edge} (clock {i})"
+        prev_i = i
+    # deltas: consecutive snapshots (no other snapshot in between) differ by SNAP_DELTA
+    checked = 0
+    for (_, a), (_, b) in zip(snaps, snaps[1:]):
+        ia, ib = trace.clock_of(a["time"]), trace.clock_of(b["time"])
+        if ib > ia and not any(trace.tb[k] == 0 for k in range(ia, ib)):
+            steps = trace.count[ib + 1] - trace.count[ia + 1]
+            if s32(b["delta"]) == steps:
+                checked += 1
+    assert checked >= 1, "no snapshot pair showed SNAP_DELTA = the count change between them"
+    trace.task.cancel()
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
+async def snapshot_deltas_across_wraps(dut):
+    """SNAP_DELTA counts applied steps across modulo wraps and limits; SNAP_EDGE_DELTA is the
+    count change between the last selected edges (any edge, and A rising with x4 counting)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for mode, edge in (("modulo", "any"), ("modulo", "a_rising"), ("limit", "any"), ("free", "a_rising")):
+        ceiling = 9 if mode != "free" else None
+        await env.setup(model, rng_mode=mode, count=3, ceiling=ceiling)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        await env.settle()
+        model.delta = 0
+        pos_hist = [env.pos]  # 4X positions, for the A-rising edge deltas
+        prev_edge_pos = None
+        for seg in range(6):
+            steps = [rng.choice([1, 1, 1, -1])] * rng.randint(5, 40)
+            wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
+            await env.play(wf, model)
+            pos_hist += wf.positions[1:]
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+            await env.settle(4)
+            snap = await read_snapshot(bus)
+            assert s32(snap["delta"]) == model.delta, \
+                f"{mode}: SNAP_DELTA {s32(snap['delta'])}, model {model.delta} applied steps"
+            # edge delta: position change between the last selected edges, in free/modulo
+            # every step is applied, so counts = positions
+            if mode != "limit":
+                if edge == "any":
+                    last = len(pos_hist) - 1
+                else:
+                    rises = [k for k in range(1, len(pos_hist))
+                             if QUAD[pos_hist[k - 1] % 4][0] == 0 and QUAD[pos_hist[k] % 4][0] == 1]
+                    last = rises[-1] if rises else None
+                if last is not None and prev_edge_pos is not None:
+                    exp = pos_hist[last] - prev_edge_pos
+                    assert s32(snap["edge_delta"]) == exp, \
+                        f"{mode}/{edge}: SNAP_EDGE_DELTA {s32(snap['edge_delta'])}, expected {exp}"
+                if last is not None:
+                    prev_edge_pos = pos_hist[last]
+            model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
+async def prescaler_and_snap_in(dut):
+    """TIMEBASE advances once every PRESCALE + 1 clocks: snap_in rising edges G clocks apart give
+    SNAP_TIME values G / (PRESCALE + 1) apart (floor or ceiling); snap_in held high snaps once."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_w = int(dut.TS_W.value)
+    ts_mask = (1 << ts_w) - 1
+    cyc = 0
+
+    async def count_clocks():
+        nonlocal cyc
+        while True:
+            await RisingEdge(dut.clk)
+            cyc += 1
+
+    counter = cocotb.start_soon(count_clocks())
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1))
+
+    async def snap(hold):
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 1
+        at = cyc
+        await ClockCycles(dut.clk, hold)
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 0
+        await env.settle(2)
+        return at, await bus.rd("SNAP_TIME")
+
+    for pre in (0, 1, 2, 9, 255):
+        await bus.wr("TB_PRESCALE", pre)
+        await env.settle(5)
+        c0, t0 = await snap(rng.randint(1, 4))
+        await ClockCycles(dut.clk, rng.randint(100, 700))
+        await bus.events()
+        c1, t1 = await snap(rng.randint(1, 4))
+        assert "SNAP_READY" in await bus.events()
+        gap = c1 - c0
+        diff = (t1 - t0) & ts_mask
+        lo, hi = gap // (pre + 1), -(-gap // (pre + 1))
+        assert lo <= diff <= hi, f"PRESCALE {pre}: {gap} clocks gave {diff} ticks, not {lo}..{hi}"
+        # the timebase itself: two reads G clocks apart
+        tb0 = await bus.rd("TIMEBASE")
+        assert 0 <= (tb0 - t1) & ts_mask <= 80 // (pre + 1) + 1
+    counter.cancel()
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
+async def period_capture(dut):
+    """PERIOD over N edges at constant speed, the direction-change flag, PERIOD_READY, and the
+    overflow flag and PERIOD_OVF event (TS_W = 16 builds only: 65,536 ticks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    lsb = regmap()["PERIOD_CTRL"].fields
+    for edge, n, d in (("any", 4, 7), ("any", 1, 12), ("a_rising", 2, 5)):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE=edge, N=n))
+        # states of exactly d clocks: every edge interval is d clocks
+        steps = [1] * 40
+        wf = walk(steps, [d * T_NS] * 40, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        period = await bus.rd("PERIOD")
+        per_edge = d * (4 if edge == "a_rising" else 1)
+        assert period == n * per_edge, f"{edge} N={n} states {d}: PERIOD {period}, expected {n * per_edge}"
+        assert not ctrl >> lsb["OVERFLOW"].lsb & 1 and not ctrl >> lsb["DIR_CHANGE"].lsb & 1
+        assert "PERIOD_READY" in await bus.events()
+        # a reversal inside a measurement sets DIR_CHANGE for that one
+        wf = walk([1, 1, -1, -1, -1] + [-1] * 12, [d * T_NS] * 17, start_pos=env.pos)
+        await env.play(wf, None)
+        env_ctrl = await bus.rd("PERIOD_CTRL")
+        assert n == 1 or True
+        wf = walk([1] * 20, [d * T_NS] * 20, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        assert not ctrl >> lsb["DIR_CHANGE"].lsb & 1, "DIR_CHANGE stuck after a clean measurement"
+        del env_ctrl
+    # direction change caught: N = 8 any edges around a reversal, read right after that capture
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=8))
+    wf = walk([1] * 3, [6 * T_NS] * 3, start_pos=env.pos)
+    await env.play(wf, None)  # first edges: start the measurement
+    wf = walk([1, 1, -1, -1, -1, -1, -1, -1], [6 * T_NS] * 8, start_pos=env.pos)
+    await bus.events()
+    await env.play(wf, None)
+    ctrl = await bus.rd("PERIOD_CTRL")
+    assert ctrl >> lsb["DIR_CHANGE"].lsb & 1, "a reversal inside the measurement did not set DIR_CHANGE"
+    if int(dut.TS_W.value) == 16:
+        await bus.events()
+        await env.settle(65540)
+        assert "PERIOD_OVF" in await bus.events()
+        wf = walk([1] * 9, [6 * T_NS] * 9, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        assert ctrl >> lsb["OVERFLOW"].lsb & 1, "OVERFLOW flag not set"
+        assert await bus.rd("PERIOD") == 0xFFFF
+    else:
+        dut._log.info("TS_W = %d: period overflow is checked in the TS_W = 16 build", int(dut.TS_W.value))
+    await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb.test()
+async def stall_and_recovery(dut):
+    """STALL_TIMEOUT: the stall event and STATUS.STALLED after that many ticks without a count
+    edge, not before; cleared by the next edge; once per stop."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0)
+    stalled_lsb = regmap()["STATUS"].fields["STALLED"].lsb
+    await bus.wr("TB_PRESCALE", 1)  # a tick every 2 clocks
+    await bus.wr("STALL_TIMEOUT", 150)  # 300 clocks
+    for rep in range(2):
+        wf = walk([1] * 10, durations(rng, 10), start_pos=env.pos)
+        await env.play(wf, None)
+        await bus.events()
+        await ClockCycles(dut.clk, 180)
+        assert "STALL" not in await bus.events(), "stall before the timeout"
+        assert not (await bus.rd("STATUS")) >> stalled_lsb & 1
+        await ClockCycles(dut.clk, 200)
+        assert "STALL" in await bus.events(), "no stall after the timeout"
+        assert (await bus.rd("STATUS")) >> stalled_lsb & 1
+        await ClockCycles(dut.clk, 400)
+        assert "STALL" not in await bus.events(), "the stall event repeated during one stop"
+        await env.play(walk([-1], [30.0], start_pos=env.pos), None)
+        assert not (await bus.rd("STATUS")) >> stalled_lsb & 1, "STALLED not cleared by an edge"
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("TB_PRESCALE", 0)
+
+
 # ---- pytest ---------------------------------------------------------------------------------------------
 CONFIGS = [("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16)]
 
