@@ -711,9 +711,24 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
     return res
 
 
+def rtl_revision() -> str:
+    """The git revision of rtl/ that was simulated (and whether rtl/ had uncommitted changes)."""
+    import subprocess
+
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=TOP, capture_output=True,
+                             text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "rtl"], cwd=TOP,
+                               capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "an unknown revision (no git)"
+    return f"commit {rev}" + (" with uncommitted changes in rtl/" if dirty else "")
+
+
 def sim_report(args, units, results, wall, sim, errors) -> dict:
     """Markdown lines, goal verdicts and plot points of the simulated layer."""
-    L = [f"{len(results)} cases simulated on {sim} in {wall:.0f} s ({args.jobs} process(es)): "
+    L = [f"RTL of {rtl_revision()}. "
+         f"{len(results)} cases simulated on {sim} in {wall:.0f} s ({args.jobs} process(es)): "
          f"the units *{'*, *'.join(n for n, _ in units[:SIM_UNITS])}* at each speed, a few 1 kHz "
          "reads each (the first initialises, the first new edge is a reference). *Added*: max "
          "|reading from the simulated registers − the same estimator on the model's exact times "
