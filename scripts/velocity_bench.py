@@ -437,8 +437,6 @@ SIM_STALL_S = 2e-3     # ... with this stall timeout (STALL_TIMEOUT and the esti
 def sim_cases(args, units, rpms, rng):
     """Short windows: --sim-reads reads at 1 kHz, more where a cycle is long (at least two
     A-rising edges after the reference one)."""
-    import numpy as np
-
     cases = []
     sim_rpms = [r for r in rpms if r >= GOAL_BAND[0]]
     if args.quick:
@@ -841,8 +839,6 @@ def worst(rows: dict, key: str, metric: str, units=None) -> float:
 
 def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> list[str]:
     """The Markdown report; returns the list of goal verdict lines."""
-    import numpy as np
-
     tb = timebase(args)
     typ = [n for n, _ in units if n != "ideal"]
     rpms = model["rpms"]

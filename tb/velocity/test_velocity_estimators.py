@@ -13,7 +13,6 @@ TS_W bits and count wrap at COUNT_W bits, each on hand-made snapshots through bo
 from __future__ import annotations
 
 import math
-import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -143,7 +142,7 @@ def test_standstill_bound_never_zero_between_edges(c_estimator):
     M reads 0 nine times out of ten (that is the unit-time method). The first edge (10 ms) is a
     reference only, the second (20 ms) gives the first measurement."""
     cfg = EstimatorConfig(tick_s=TICK, ts_w=32, counts_per_edge=1, stall_ticks=50_000)
-    snaps, count, edge_t, prev_edge_count = [], 0, 0, 0
+    snaps, count, prev_edge_count = [], 0, 0
     for k in range(0, 60):
         t = 1000 * k + 500
         new = t // 10_000 * 10_000

@@ -57,7 +57,7 @@ pipeline latency, timebase = clocks / (PRESCALE + 1) modulo 2^TS_W).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
