@@ -128,7 +128,7 @@ module enc_qei #(
   );
 
   // ---- core ---------------------------------------------------------------------------------------------
-  wire [COUNT_W-1:0] count_unused, count_next, idx_latch, probe_latch;
+  wire [COUNT_W-1:0] count_q, idx_latch, probe_latch;
   wire [TS_W-1:0]    probe_time;
   wire [TS_W-1:0]    timebase;
   wire a_eff, b_eff, z_eff, dir, idx_armed, stopped, idx_disarm, probe_disarm;
@@ -174,8 +174,7 @@ module enc_qei #(
       .count_hi_wdata(count_hi_wdata),
       .count_lo_rdata(count_lo_rdata),
       .count_hi_rdata(count_hi_rdata),
-      .count         (count_unused),
-      .count_next    (count_next),
+      .count         (count_q),
       .idx_latch     (idx_latch),
       .probe_latch   (probe_latch),
       .probe_time    (probe_time),
@@ -223,7 +222,7 @@ module enc_qei #(
       .applied_up     (applied_up),
       .applied_dn     (applied_dn),
       .dir_change     (ev_dir_change),
-      .count_next     (count_next),
+      .count          (count_q),
       .snap_cmd       (snap_cmd),
       .snap_in        (snap_in),
       .snap_in_en     (snap_in_en),

@@ -61,7 +61,6 @@ module enc_qei_core #(
     output wire [31:0]        count_hi_rdata,
     // state
     output wire [COUNT_W-1:0] count,
-    output wire [COUNT_W-1:0] count_next,     // the count after this clock
     output wire [COUNT_W-1:0] idx_latch,
     output wire [COUNT_W-1:0] probe_latch,
     output wire [TS_W-1:0]    probe_time,
@@ -432,7 +431,6 @@ module enc_qei_core #(
 
   // ---- outputs ---------------------------------------------------------------------------------------
   assign count        = count_q;
-  assign count_next   = count_d;
   assign idx_latch    = idx_latch_q;
   assign probe_latch  = probe_latch_q;
   assign probe_time   = probe_time_q;

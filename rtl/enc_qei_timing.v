@@ -3,17 +3,21 @@
 // detection (the velocity side of the peripheral: unit-time M, period T and timestamp M/T).
 //
 // Timebase: TS_W bits, +1 every PRESCALE + 1 clocks (`tick`), wrapping; a change of PRESCALE
-// restarts the prescaler. Every time below is in its ticks, and an edge's timestamp is the
-// timebase value in the clock the core reports the edge (the same clock the count takes it).
+// restarts the prescaler. Every time below is in its ticks. The core's edge and step pulses are
+// registered on the way in (timing), so everything here sees the core one clock late, all alike:
+// an edge's timestamp is the timebase in the clock after the count took it, and a snapshot holds
+// the count register (`count`, which already includes the previous clock's step) with the edges
+// and steps up to that same point.
 // Snapshot: a request -- snap_cmd, a rising edge of snap_in while snap_in_en, or the unit timer
 // (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in that one clock:
-//   SNAP_COUNT      the count after this clock (count_next)
+//   SNAP_COUNT      the count register now (count)
 //   SNAP_TIME       the timebase now
 //   SNAP_EDGE_TIME  the timestamp of the last edge of the selected type (this clock's included)
 //   SNAP_DELTA      the applied count steps since the previous snapshot (this clock's included)
 //   SNAP_EDGE_DELTA the applied steps between the previous snapshot's last selected edge and this
-//                   one's: prev_tail + delta - tail, where tail counts the steps after the last
-//                   selected edge (the step of an edge's own clock belongs before it)
+//                   one's: `head` adds up, at each selected edge, the steps since the edge before
+//                   (`tail` plus the edge's own step), and restarts at each snapshot
+// Both deltas are 32-bit two's complement and wrap (2^31 steps between two snapshots).
 // Period: while period_en, every period_n (0 acts as 1) selected edges the ticks since the edge
 // that started the measurement go to PERIOD (timebase(end) - timebase(start)); the end edge starts
 // the next one. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
@@ -37,7 +41,7 @@ module enc_qei_timing #(
     input  wire               applied_up,      // the count took a +1 step
     input  wire               applied_dn,      // the count took a -1 step
     input  wire               dir_change,      // a step against the previous step's direction
-    input  wire [COUNT_W-1:0] count_next,      // the count after this clock
+    input  wire [COUNT_W-1:0] count,           // the count register
     // snapshot (SNAP_CTRL, SNAP_PERIOD)
     input  wire               snap_cmd,
     input  wire               snap_in,
@@ -71,20 +75,26 @@ module enc_qei_timing #(
   localparam [TS_W-1:0] TS_ONE  = {{(TS_W-1){1'b0}}, 1'b1};
   localparam [TS_W-1:0] TS_ZERO = {TS_W{1'b0}};
   localparam [TS_W-1:0] TS_MAX  = {TS_W{1'b1}};
-  localparam signed [33:0] SAT_HI = 34'sh0_7FFF_FFFF;
-  localparam signed [33:0] SAT_LO = -34'sh0_7FFF_FFFF;
+  // ---- inputs from the core, registered --------------------------------------------------------------
+  reg edge_any_q, edge_a_rise_q, step_q, up_q, dn_q, dir_change_q;
 
-  // 34-bit signed to 32-bit, saturating at +/-(2^31 - 1) (the top bits of c are the sign only)
-  // verilator lint_off UNUSEDSIGNAL
-  function [31:0] sat32;
-    input signed [33:0] v;
-    reg   signed [33:0] c;
-    begin
-      c     = (v > SAT_HI) ? SAT_HI : (v < SAT_LO) ? SAT_LO : v;
-      sat32 = c[31:0];
+  always @(posedge clk) begin
+    if (rst) begin
+      edge_any_q    <= 1'b0;
+      edge_a_rise_q <= 1'b0;
+      step_q        <= 1'b0;
+      up_q          <= 1'b0;
+      dn_q          <= 1'b0;
+      dir_change_q  <= 1'b0;
+    end else begin
+      edge_any_q    <= edge_any;
+      edge_a_rise_q <= edge_a_rise;
+      step_q        <= step;
+      up_q          <= applied_up;
+      dn_q          <= applied_dn;
+      dir_change_q  <= dir_change;
     end
-  endfunction
-  // verilator lint_on UNUSEDSIGNAL
+  end
 
   // ---- timebase ----------------------------------------------------------------------------------
   reg [15:0]     pre_q;
@@ -129,18 +139,17 @@ module enc_qei_timing #(
     end
   end
 
-  wire               sel_snap = snap_edge ? edge_a_rise : edge_any;
-  wire signed [33:0] s_now    = applied_up ? 34'sd1 : applied_dn ? -34'sd1 : 34'sd0;
-  reg  signed [33:0] delta_q;     // applied steps since the previous snapshot
-  reg  signed [33:0] tail_q;      // applied steps since the last selected edge
-  reg  signed [33:0] prev_tail_q; // tail at the previous snapshot
-  reg  [TS_W-1:0]    last_edge_q; // timestamp of the last selected edge
-  wire signed [33:0] delta_now = delta_q + s_now;
-  wire signed [33:0] tail_now  = sel_snap ? 34'sd0 : tail_q + s_now;
-  wire [TS_W-1:0]    edge_now  = sel_snap ? tb_q : last_edge_q;
-  // accumulators saturate well inside 34 bits
-  wire signed [33:0] delta_sat = (delta_now > SAT_HI) ? SAT_HI : (delta_now < SAT_LO) ? SAT_LO : delta_now;
-  wire signed [33:0] tail_sat  = (tail_now > SAT_HI) ? SAT_HI : (tail_now < SAT_LO) ? SAT_LO : tail_now;
+  wire        sel_snap  = snap_edge ? edge_a_rise_q : edge_any_q;
+  wire [31:0] s_now     = up_q ? 32'd1 : dn_q ? 32'hFFFF_FFFF : 32'd0;
+  reg  [31:0] delta_q;      // applied steps since the previous snapshot
+  reg  [31:0] tail_q;       // applied steps since the last selected edge
+  reg  [31:0] head_q;       // steps from the previous snapshot's last selected edge to the last one
+  reg  [TS_W-1:0] last_edge_q;  // timestamp of the last selected edge
+  wire [31:0] delta_now = delta_q + s_now;
+  wire [31:0] tail_s    = tail_q + s_now;
+  wire [31:0] tail_now  = sel_snap ? 32'd0 : tail_s;
+  wire [31:0] head_now  = sel_snap ? head_q + tail_s : head_q;
+  wire [TS_W-1:0] edge_now = sel_snap ? tb_q : last_edge_q;
 
   reg [COUNT_W-1:0] snap_count_q;
   reg [TS_W-1:0]    snap_time_q;
@@ -150,9 +159,9 @@ module enc_qei_timing #(
 
   always @(posedge clk) begin
     if (rst) begin
-      delta_q           <= 34'sd0;
-      tail_q            <= 34'sd0;
-      prev_tail_q       <= 34'sd0;
+      delta_q           <= 32'd0;
+      tail_q            <= 32'd0;
+      head_q            <= 32'd0;
       last_edge_q       <= TS_ZERO;
       snap_count_q      <= {COUNT_W{1'b0}};
       snap_time_q       <= TS_ZERO;
@@ -160,24 +169,25 @@ module enc_qei_timing #(
       snap_delta_q      <= 32'd0;
       snap_edge_delta_q <= 32'd0;
     end else begin
-      tail_q      <= tail_sat;
+      tail_q      <= tail_now;
       last_edge_q <= edge_now;
       if (snap_req) begin
-        delta_q           <= 34'sd0;
-        prev_tail_q       <= tail_sat;
-        snap_count_q      <= count_next;
+        delta_q           <= 32'd0;
+        head_q            <= 32'd0;
+        snap_count_q      <= count;
         snap_time_q       <= tb_q;
         snap_edge_time_q  <= edge_now;
-        snap_delta_q      <= sat32(delta_sat);
-        snap_edge_delta_q <= sat32(prev_tail_q + delta_sat - tail_sat);
+        snap_delta_q      <= delta_now;
+        snap_edge_delta_q <= head_now;
       end else begin
-        delta_q <= delta_sat;
+        delta_q <= delta_now;
+        head_q  <= head_now;
       end
     end
   end
 
   // ---- period ---------------------------------------------------------------------------------------
-  wire       sel_per  = period_edge ? edge_a_rise : edge_any;
+  wire       sel_per  = period_edge ? edge_a_rise_q : edge_any_q;
   wire [7:0] per_last = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
   reg        started_q, ovf_q, dir_q;
   reg [7:0]  n_q;
@@ -210,13 +220,13 @@ module enc_qei_timing #(
       if (capture) begin
         period_q     <= ovf_q ? TS_MAX : ticks_q;
         period_ovf_q <= ovf_q;
-        period_dir_q <= dir_q | dir_change;
+        period_dir_q <= dir_q | dir_change_q;
       end
     end else if (started_q) begin
       if (sel_per) begin
         n_q <= n_q + 8'd1;
       end
-      dir_q <= dir_q | dir_change;
+      dir_q <= dir_q | dir_change_q;
       if (tick) begin
         if (ticks_q == TS_MAX) begin
           ovf_q <= 1'b1;
@@ -230,14 +240,14 @@ module enc_qei_timing #(
   // ---- stall ----------------------------------------------------------------------------------------
   reg [TS_W-1:0] stall_q;
   reg            stalled_q;
-  wire           stall_hit = (stall_timeout != TS_ZERO) & ~stalled_q & ~step & tick &
+  wire           stall_hit = (stall_timeout != TS_ZERO) & ~stalled_q & ~step_q & tick &
                              ((stall_q + TS_ONE) >= stall_timeout);
 
   always @(posedge clk) begin
     if (rst) begin
       stall_q   <= TS_ZERO;
       stalled_q <= 1'b0;
-    end else if (step | (stall_timeout == TS_ZERO)) begin
+    end else if (step_q | (stall_timeout == TS_ZERO)) begin
       stall_q   <= TS_ZERO;
       stalled_q <= 1'b0;
     end else if (tick & ~stalled_q) begin

@@ -719,10 +719,12 @@ class ClockTrace:
         raise AssertionError(f"no clock with timebase {tb_value}")
 
     def last_edge_time(self, i: int, a_rising: bool) -> int | None:
+        """Timestamp of the last edge a snapshot in clock i includes: an edge of clock j <= i - 1,
+        stamped with the timebase of clock j + 1 (the timing unit sees the core a clock late)."""
         edges = self.arise if a_rising else self.any
-        for j in range(i, -1, -1):
+        for j in range(i - 1, -1, -1):
             if edges[j]:
-                return self.tb[j]
+                return self.tb[j + 1]
         return None
 
 
@@ -778,10 +780,10 @@ async def snapshot_coherence(dut):
     for edge, s in snaps:
         i = trace.clock_of(s["time"], after=0 if prev_i is None else max(prev_i - 5, 0))
         count = (s["count_hi"] << 32 | s["count"]) & model.max
-        assert count == trace.count[i + 1], f"SNAP_COUNT {count} is not the count of clock {i}"
+        assert count == trace.count[i], f"SNAP_COUNT {count} is not the count of clock {i}"
         exp_edge = trace.last_edge_time(i, edge == "a_rising")
         edges = trace.arise if edge == "a_rising" else trace.any
-        if not any(edges[switched[edge] + 2:i + 1]):
+        if not any(edges[switched[edge] + 2:i]):
             exp_edge = None  # no edge of the new type since EDGE changed: not defined yet
         if exp_edge is not None:
             assert s["edge_time"] == exp_edge & ts_mask, \
@@ -792,7 +794,7 @@ async def snapshot_coherence(dut):
     for (_, a), (_, b) in zip(snaps, snaps[1:]):
         ia, ib = trace.clock_of(a["time"]), trace.clock_of(b["time"])
         if ib > ia and not any(trace.tb[k] == 0 for k in range(ia, ib)):
-            steps = trace.count[ib + 1] - trace.count[ia + 1]
+            steps = trace.count[ib] - trace.count[ia]
             if s32(b["delta"]) == steps:
                 checked += 1
     assert checked >= 1, "no snapshot pair showed SNAP_DELTA = the count change between them"
