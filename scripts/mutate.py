@@ -64,6 +64,7 @@ REVIEWED = TOP / "scripts" / "mutate_reviewed.txt"
 RESULTS_MD = TOP / "doc" / "results" / "mutation.md"
 DEFAULT_SEED = 1
 DEFAULT_N = 25
+MITER_STEPS = 24  # clocks of the bounded output check of a survivor (equivalence(), stage 2)
 
 T_LS168 = "tb/ls168/test_ls168.py"
 T_COND = "tb/enc_conditioner/test_enc_conditioner.py"
@@ -114,13 +115,14 @@ MODULES: dict[str, dict] = {
             for d, m, f in ((4, 10, 3), (4, 16, 1), (1, 10, 2), (1, 16, 3), (8, 10, 8), (8, 16, 3))
         ],
     },
+    # The phase meter's behaviour tests (reset, reversal, standstill, cadence, accuracy) run at
+    # WINDOW_LOG2 = 13; at 16 and 17 the tests are accuracy runs only (frequency_case, +-0.25
+    # degree = +-64 LSB), which by design cannot see a wrong LSB or a broken reset: mutated there,
+    # 13 of 50 survived (seed 1). Those corners stay out (doc/mutation.md); the behaviour tests
+    # at 16 or 17 would take 8 to 16 times as long per mutant.
     "enc_phase_meter": {
         "file": "rtl/enc_phase_meter.v",
-        "corners": [
-            ({"WINDOW_LOG2": 13}, [f"{T_PHASE}::test_enc_phase_meter"]),
-            ({"WINDOW_LOG2": 16}, [f"{T_PHASE}::test_enc_phase_meter_speed[16-1000.0-3]"]),
-            ({"WINDOW_LOG2": 17}, [f"{T_PHASE}::test_enc_phase_meter_speed[17-10000.0-1]"]),
-        ],
+        "corners": [({"WINDOW_LOG2": 13}, [f"{T_PHASE}::test_enc_phase_meter"])],
     },
     "enc_characterizer": {
         "file": "rtl/enc_characterizer.v",
@@ -423,7 +425,7 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
 
     def side(name: str, mutate: str) -> str:
         return (f"read_rtlil {rel}/orig.il\n{mutate}{deps}hierarchy -top {c.module}\n"
-                f"proc\nflatten\nopt_clean\nrename {c.module} {name}\n")
+                f"proc\nflatten\nmemory_map\nopt_clean\nrename {c.module} {name}\n")
 
     script = (side("gold", "") + "design -stash gold\n" + side("gate", m.command + "\n")
               + "design -copy-from gold -as gold gold\n"
@@ -435,13 +437,38 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
     except subprocess.TimeoutExpired:
         return False, "equivalence check timed out"
     if proc.returncode == 0:
-        return True, "proven equivalent"
+        return True, "proven equivalent (equiv_induct)"
     text = log.read_text() if log.exists() else proc.stdout + proc.stderr
     um = re.search(r"Found (\d+) unproven \$equiv cells", text)
-    if um:
-        return False, f"{um.group(1)} unproven $equiv cells"
+    first = f"{um.group(1)} unproven $equiv cells" if um else "equiv_make failed"
+
+    # 2. The ports only: a miter of the two from the all-zero state (the simulation's start: see
+    # setundef above), every input free in every clock (rst too), temporal induction up to
+    # MITER_STEPS. A proof makes the mutant equivalent; a base-case failure is a trace on which
+    # the outputs differ (the tests miss it); otherwise no difference within MITER_STEPS clocks
+    # (a register that differs but is never read, for instance): a survivor to review.
+    script = (side("gold", "") + "design -stash gold\n" + side("gate", m.command + "\n")
+              + "design -copy-from gold -as gold gold\n"
+              + "miter -equiv -flatten -make_outputs gold gate miter\n"
+              + "hierarchy -top miter\n"
+              + f"sat -tempinduct -prove trigger 0 -set-init-zero -seq 1 -maxsteps {MITER_STEPS} "
+              + f"-timeout 120 -show-ports miter\n")
+    log = d / f"m{m.number:02d}_miter.log"
+    try:
+        proc = run_yosys(script, log, timeout=300)
+    except subprocess.TimeoutExpired:
+        return False, f"{first}; miter timed out"
+    text = log.read_text() if log.exists() else proc.stdout + proc.stderr
+    if proc.returncode == 0 and re.search(r"Induction step proven: SUCCESS", text):
+        return True, f"proven equivalent (miter, temporal induction)"
+    if re.search(r"model found for base case", text):
+        return False, f"{first}; outputs differ on a trace from the zero state"
+    if re.search(r"Reached maximum number of time steps", text):
+        return False, f"{first}; no output difference within {MITER_STEPS} clocks of the zero state"
+    if "timeout" in text.lower():
+        return False, f"{first}; miter: solver timeout"
     err = re.search(r"ERROR: (.*)", text)
-    return False, f"check failed: {err.group(1) if err else 'see ' + str(log.relative_to(TOP))}"
+    return False, f"{first}; miter: {err.group(1) if err else 'see ' + str(log.relative_to(TOP))}"
 
 
 # ------------------------------------------------------------------------------------------------
