@@ -21,13 +21,16 @@ Two layers:
     (cocotb: ``scripts/benches/velocity_bench_sim.py``): the host writes SNAP_CTRL.CMD and reads
     the snapshot registers; the readings are compared with the floor on the same edges (each
     SNAP_EDGE_TIME is matched to its model edge) and SNAP_EDGE_DELTA with the model's count.
-    Skipped, and said so, when the RTL lacks the timing registers.
+    Skipped, and said so, when the RTL lacks the timing registers. ``--rtl-rev REV`` simulates
+    rtl/ as of a git revision (through the harness's ENC_RTL_OVERRIDE) instead of the working
+    tree; the table names the revision either way.
 
 Writes doc/results/velocity_methods.md and sim/figures/velocity_methods.png; one progress line
 per speed. Usage:
   scripts/velocity_bench.py [--rpm-min R] [--rpm-max R] [--points N] [--units N] [--seed N]
                             [--quick] [--jobs N] [--sim auto|none|icarus|verilator]
-                            [--sim-reads N] [--prescale P] [--clk-mhz F] [--stall-ms T]
+                            [--sim-reads N] [--rtl-rev REV] [--prescale P] [--clk-mhz F]
+                            [--stall-ms T]
 """
 
 from __future__ import annotations
@@ -103,6 +106,9 @@ def parse_args(argv=None):
     p.add_argument("--jobs", type=_num(int, 1, 64), default=2, help="worker processes")
     p.add_argument("--sim", choices=("auto", "none", "icarus", "verilator"), default="auto",
                    help="simulated layer through enc_qei (auto: Verilator if present, else Icarus)")
+    p.add_argument("--rtl-rev", default=None, metavar="REV",
+                   help="simulate rtl/ (and its RDL) as of this git revision instead of the "
+                        "working tree")
     p.add_argument("--sim-reads", type=_num(int, 3, 200), default=6,
                    help="1 kHz reads per speed in the simulated layer (default 6)")
     p.add_argument("--prescale", type=_num(int, 0, 65535), default=0,
@@ -112,6 +118,14 @@ def parse_args(argv=None):
     p.add_argument("--stall-ms", type=_num(float, 0, 10000, lo_open=True), default=200.0,
                    help="stall timeout of the estimators, ms (default 200)")
     a = p.parse_args(argv)
+    if a.rtl_rev is not None:
+        import subprocess
+
+        res = subprocess.run(["git", "rev-parse", "--verify", "--quiet", f"{a.rtl_rev}^{{commit}}"],
+                             cwd=TOP, capture_output=True, text=True)
+        if res.returncode != 0:
+            p.error(f"--rtl-rev {a.rtl_rev!r} is not a git revision of this repository")
+        a.rtl_rev = res.stdout.strip()
     if a.rpm_min >= a.rpm_max:
         p.error(f"--rpm-min ({a.rpm_min:g}) must be below --rpm-max ({a.rpm_max:g})")
     tick = (a.prescale + 1) / (a.clk_mhz * 1e6)
@@ -398,14 +412,14 @@ def default_sim() -> str:
     return "verilator" if venv_verilator or shutil.which("verilator") else "icarus"
 
 
-def reg_layout() -> tuple[dict, dict, int]:
+def reg_layout(rdl: Path | None = None) -> tuple[dict, dict, int]:
     """Register offsets, field LSBs ("REG.FIELD") and the a_rising edge-type value, from the
     RDL (rtl/enc_qei.rdl is the single source of truth)."""
     sys.path.insert(0, str(TOP / "scripts"))
     from gen_regs import compile_rdl
 
     regs, bits, a_rising = {}, {}, None
-    for r in compile_rdl().registers():
+    for r in (compile_rdl(rdl) if rdl else compile_rdl()).registers():
         regs[r.inst_name] = r.address_offset
         for f in r.fields():
             bits[f"{r.inst_name}.{f.inst_name}"] = f.lsb
@@ -424,6 +438,25 @@ def qei_sources() -> tuple[Path, ...]:
         from harness import rtl_sources
         have = {p.name for p in rtl_sources()}
         return tuple(p for p in sorted((TOP / "rtl").glob("enc_*.v")) if p.name not in have)
+
+
+def rtl_snapshot(rev: str, dest: Path) -> Path:
+    """rtl/ as of git revision ``rev``, written to ``dest``; ENC_RTL_OVERRIDE (the harness's
+    hook) then makes the simulation use those files."""
+    import subprocess
+
+    names = subprocess.run(["git", "ls-tree", "--name-only", rev, "rtl/"], cwd=TOP,
+                           capture_output=True, text=True, check=True).stdout.split()
+    dest.mkdir(parents=True, exist_ok=True)
+    over = []
+    for name in names:
+        data = subprocess.run(["git", "show", f"{rev}:{name}"], cwd=TOP, capture_output=True,
+                              check=True).stdout
+        (dest / Path(name).name).write_bytes(data)
+        if name.endswith(".v"):
+            over.append(f"{name}={dest / Path(name).name}")
+    os.environ["ENC_RTL_OVERRIDE"] = ",".join(over)
+    return dest
 
 
 SIM_UNITS = 2          # the ideal unit and the first typical one
@@ -482,17 +515,27 @@ def run_sim(args, units, rpms) -> dict:
         from harness import run
     except ImportError as e:
         return {"skipped": f"the cocotb harness does not import ({e})"}
-    regs, bits, a_rising = reg_layout()
+    tmp = Path(tempfile.mkdtemp(prefix="velocity_sim_"))
+    sources = qei_sources()
+    rdl = None
+    if args.rtl_rev:
+        snap = rtl_snapshot(args.rtl_rev, tmp / "rtl")
+        rdl = snap / "enc_qei.rdl"
+        if not rdl.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+            return {"skipped": f"rtl/enc_qei.rdl does not exist at {args.rtl_rev[:10]}"}
+        sources = tuple(snap / p.name if (snap / p.name).exists() else p for p in sources)
+    regs, bits, a_rising = reg_layout(rdl)
     need = ("TB_PRESCALE", "PERIOD_CTRL", "STALL_TIMEOUT", "SNAP_CTRL", "TIMEBASE") + READ_REGS
     missing = [r for r in need if r not in regs]
     if missing or a_rising is None:
+        shutil.rmtree(tmp, ignore_errors=True)
         return {"skipped": "rtl/enc_qei.rdl lacks " + ", ".join(missing or ["SNAP_CTRL.EDGE"])}
     rng = np.random.default_rng([args.seed, 2])
     cases = sim_cases(args, units, rpms, rng)
     tb = timebase(args)
     clk_ps = int(round(1e6 / args.clk_mhz))
     groups = [cases[i::args.jobs] for i in range(min(args.jobs, len(cases)))]
-    tmp = Path(tempfile.mkdtemp(prefix="velocity_sim_"))
     plans = []
     for gi, grp in enumerate(groups):
         plan = {"clk_ps": clk_ps, "regs": regs, "bits": bits, "cases": [
@@ -516,7 +559,7 @@ def run_sim(args, units, rpms) -> dict:
                "COCOTB_LOG_LEVEL": "WARNING"}
         try:
             run("enc_qei_wb", "velocity_bench_sim", name=f"velocity_sim_{gi}",
-                parameters={"COUNT_W": 32, "TS_W": 32}, extra_sources=qei_sources(),
+                parameters={"COUNT_W": 32, "TS_W": 32}, extra_sources=sources,
                 testcase="velocity_reads", extra_env=env, quiet=True)
         except BaseException as e:   # noqa: BLE001 -- reported below, the model layer stands
             errors[gi] = f"{type(e).__name__}: {e}"
@@ -709,10 +752,12 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
     return res
 
 
-def rtl_revision() -> str:
+def rtl_revision(rev: str | None = None) -> str:
     """The git revision of rtl/ that was simulated (and whether rtl/ had uncommitted changes)."""
     import subprocess
 
+    if rev:
+        return f"commit {rev[:7]} (--rtl-rev)"
     try:
         rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=TOP, capture_output=True,
                              text=True, check=True).stdout.strip()
@@ -725,7 +770,7 @@ def rtl_revision() -> str:
 
 def sim_report(args, units, results, wall, sim, errors) -> dict:
     """Markdown lines, goal verdicts and plot points of the simulated layer."""
-    L = [f"RTL of {rtl_revision()}. "
+    L = [f"RTL of {rtl_revision(getattr(args, 'rtl_rev', None))}. "
          f"{len(results)} cases simulated on {sim} in {wall:.0f} s ({args.jobs} process(es)): "
          f"the units *{'*, *'.join(n for n, _ in units[:SIM_UNITS])}* at each speed, a few 1 kHz "
          "reads each (the first initialises, the first new edge is a reference). *Added*: max "
