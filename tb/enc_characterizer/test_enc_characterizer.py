@@ -194,6 +194,27 @@ async def reversal_abandons_window(dut):
 
 
 @cocotb.test()
+async def slow_units_wide_states(dut):
+    """A slow shaft: 2300 clocks per cycle, states of 450 to 750 clocks, so the upper bits of
+    the state, pulse, phase and period registers carry data (the other tests run 150 to 400
+    clocks per cycle: no state reaches 512 clocks, and a stuck bit 9 of the widest-state register
+    went unseen in the mutation run, issue 14). Within the state counter's range (2^CNT_W - 2
+    clocks; CNT_W >= 11 for this speed)."""
+    await start_clock(dut)
+    if int(dut.CNT_W.value) < 11:
+        dut._log.info("CNT_W < 11: states of 1000 clocks would stall the counter; skipped")
+        return
+    # the widest state is the farther extreme here (105 + 10 e-degrees against 90 - 15), so it
+    # is the one reported in state_err
+    for ch, cpc, forward in ((Channels(105.0, -10.0, 6.0), 2300.9, False),):
+        got = await run_unit(dut, ch, cpc, forward, f"slow unit {cpc} clocks/cycle "
+                             f"{'fwd' if forward else 'rev'}")
+        one = 360.0 / cpc
+        state = max(abs(w - 90) for w in ch.state_widths())
+        assert abs(abs(got["state_err"] / DEG) - state) <= 1.5 * one
+
+
+@cocotb.test()
 async def hedsmodel_units(dut):
     """Units drawn from the note's tables by the hedsmodel package, 600 rpm, clk 1 MHz (~200 clocks/cycle)."""
     from hedsmodel import EncoderUnit, Profile, measure
