@@ -53,7 +53,8 @@ FIGURE = TOP / "sim" / "figures" / "velocity_methods.png"
 RAW = TOP / "sim" / "build" / "velocity_raw.json"   # every number, not committed
 
 READ_HZ = 1000.0
-FILTER_LEN = 3                     # enc_qei's reset value; edges seen FILTER_LEN + 3 clocks late
+FILTER_LEN = 3                     # enc_qei's reset value
+LATENCY_CLOCKS = FILTER_LEN + 4    # pins to timestamp in enc_qei (RDL); a constant, it cancels
 VARIANTS = (("M", "any"), ("T", "any"), ("T", "a_rising"), ("MT", "any"), ("MT", "a_rising"))
 LABEL = {("M", "any"): "M", ("T", "any"): "T any edge", ("T", "a_rising"): "T A↑",
          ("MT", "any"): "M/T any edge", ("MT", "a_rising"): "M/T A↑"}
@@ -181,7 +182,7 @@ def timebase(args, prescale=None):
 
     return Timebase(clk_hz=args.clk_mhz * 1e6,
                     prescale=args.prescale if prescale is None else prescale, ts_w=32,
-                    latency_clocks=FILTER_LEN + 3)
+                    latency_clocks=LATENCY_CLOCKS)
 
 
 def build_profile(spec):
@@ -756,21 +757,22 @@ def rtl_revision(rev: str | None = None) -> str:
     """The git revision of rtl/ that was simulated (and whether rtl/ had uncommitted changes)."""
     import subprocess
 
-    if rev:
-        return f"commit {rev[:7]} (--rtl-rev)"
     try:
-        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=TOP, capture_output=True,
-                             text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "rtl"], cwd=TOP,
-                               capture_output=True, text=True, check=True).stdout.strip()
+        last = subprocess.run(["git", "log", "-1", "--format=%h", rev or "HEAD", "--", "rtl"],
+                              cwd=TOP, capture_output=True, text=True, check=True).stdout.strip()
+        dirty = "" if rev else subprocess.run(
+            ["git", "status", "--porcelain", "--", "rtl"], cwd=TOP, capture_output=True,
+            text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "an unknown revision (no git)"
-    return f"commit {rev}" + (" with uncommitted changes in rtl/" if dirty else "")
+    return (f"rtl/ as of commit {last} (its last change" + (f" up to {rev[:7]}, --rtl-rev)" if rev
+                                                             else ")")
+            + (", with uncommitted changes in the working tree" if dirty else ""))
 
 
 def sim_report(args, units, results, wall, sim, errors) -> dict:
     """Markdown lines, goal verdicts and plot points of the simulated layer."""
-    L = [f"RTL of {rtl_revision(getattr(args, 'rtl_rev', None))}. "
+    L = [f"Simulated: {rtl_revision(getattr(args, 'rtl_rev', None))}. "
          f"{len(results)} cases simulated on {sim} in {wall:.0f} s ({args.jobs} process(es)): "
          f"the units *{'*, *'.join(n for n, _ in units[:SIM_UNITS])}* at each speed, a few 1 kHz "
          "reads each (the first initialises, the first new edge is a reference). *Added*: max "
@@ -874,7 +876,9 @@ def fmt_pct(x, digits=3) -> str:
         return f"{v:,.0f}"
     if v >= 10:
         return f"{v:.1f}"
-    return f"{v:.{digits}f}" if v >= 0.001 or v == 0 else f"{v:.1e}"
+    if v >= 0.1:
+        return f"{v:.{digits}f}"
+    return f"{v:.2g}" if v >= 1e-3 else f"{v:.1e}"
 
 
 def worst(rows: dict, key: str, metric: str, units=None) -> float:
@@ -894,7 +898,8 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
           f"Modelled HEDS-5000 units (hedsmodel; 500 cycles/rev, x4 = 2,000 counts/rev) read at "
           f"1 kHz by the estimators of `hedsmodel.velocity` / `sw/enc_qei_velocity.c`. Timebase "
           f"{args.clk_mhz:g} MHz / (PRESCALE {args.prescale} + 1) = {tb.tick_s * 1e9:g} ns tick, "
-          f"TS_W 32; edges seen {FILTER_LEN + 3} clocks after the pins (FILTER_LEN {FILTER_LEN}); "
+          f"TS_W 32; edges timestamped {LATENCY_CLOCKS} clocks after the pins (FILTER_LEN "
+          f"{FILTER_LEN}; a constant, so it cancels); "
           f"estimator stall timeout {args.stall_ms:g} ms. Seed {args.seed}"
           f"{', --quick' if args.quick else ''}; {wall_s / 60:.1f} min on {args.jobs} "
           f"job(s). Relative errors in % of the true shaft speed: *rms* and *max* over the "
@@ -949,8 +954,9 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
           "errors) makes one state up to (90 + ΔS) e° long and another (90 − ΔS) e°. Timing "
           "between consecutive edges of *any* type measures one state, so a reading is off by "
           "up to ΔS / (90° − ΔS) -- at every speed, since it is geometry, not timing. A-rising edges are one "
-          "whole cycle apart: only the cycle error (line placement, ~0.7 e° rms) and the "
-          "once-per-revolution eccentricity remain. M/T with any edge averages the states over "
+          "whole cycle apart: only the line-placement error of the code wheel (~0.7 e° rms per "
+          "cycle in the model; the units table's cycle error is the note's Figure 3 maximum, "
+          "eccentricity included) and the once-per-revolution eccentricity remain. M/T with any edge averages the states over "
           "the read period, so its error falls as more states fit in a read (≈ ΔS / 90° divided "
           "by the states per read).", "",
           "| unit | ΔS (e°) | ΔS / (90° − ΔS) (%) | T any edge max (%) | T A↑ max (%) | M/T any max at 30 rpm (%) "
