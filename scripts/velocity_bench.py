@@ -230,6 +230,8 @@ def read_model(job) -> dict:
     out["edges"] = int(et.step.size)
     out["last_edge_s"] = float(et.t_s[-1]) if et.t_s.size else 0.0
     out["motion_end_s"] = max((pc.tb for pc in prof.pieces()), default=0.0)
+    idx = np.searchsorted(et.t_s, out["t"] - lat, side="right") - 1
+    out["last_dir"] = np.where(idx >= 0, np.sign(et.step[np.maximum(idx, 0)]), 0)
     return out
 
 
@@ -332,7 +334,8 @@ def scenario_metrics(kind, res, stall_s) -> dict:
         for key, r in res["readings"].items():
             hw = r["hw"]
             big = res["score"] & (np.abs(true) >= GOAL_NONZERO_RPM)
-            wrong = int(np.sum(big & (np.sign(hw) != np.sign(true)) & (hw != 0)))
+            told = res["last_dir"] == np.sign(true)     # the encoder has shown the direction
+            wrong = int(np.sum(big & told & (np.sign(hw) != np.sign(true)) & (hw != 0)))
             zeros = int(np.sum(big & (hw == 0)))
             out[key] = {**sc.get(key, {}), "wrong_sign": wrong, "zeros_moving": zeros,
                         "n_moving": int(np.sum(big))}
@@ -499,6 +502,17 @@ def sim_cases(args, units, rpms, rng):
                       "unit": name, "rpm": SIM_STOP_RPM, "edge_name": edge, "wf": wf,
                       "profile": spec, "stall_s": SIM_STALL_S,
                       "reads_ns": [1e6 * (t0 + k) for k in range(9)]})
+    # a ramp and a reversal, short and steep
+    for kind, spec, top, n in (
+            ("ramp", [("ramp", 600.0 * DETUNE, 3000.0 * DETUNE, 8e-3)], 3000.0, 7),
+            ("reversal", [("ramp", 150.0 * DETUNE, -150.0 * DETUNE, 16e-3)], 150.0, 15)):
+        wf = unit.waveform(build_profile(spec))
+        for edge in ("any", "a_rising"):
+            t0 = SIM_T0_MS + float(rng.uniform(0, 0.2))
+            cases.append({"id": f"{name} {kind} {edge}", "kind": kind, "unit": name, "rpm": top,
+                          "edge_name": edge, "wf": wf, "profile": spec,
+                          "stall_s": args.stall_ms * 1e-3,
+                          "reads_ns": [1e6 * (t0 + k) for k in range(n)]})
     return cases
 
 
@@ -689,8 +703,10 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
     fl = estimate(exact_twin(trace, et, med * tick), EstimatorConfig(
         tick_s=1e-9, ts_w=None, counts_per_edge=cpe, stall_ticks=stall_s * 1e9))
     # consistency of the latched values with the model
-    bad_edge_delta = bad_period = bad_delta = 0
-    checked = {"edge_delta": 0, "period": 0, "delta": 0}
+    bad_edge_delta = bad_period = bad_delta = bad_dir = 0
+    checked = {"edge_delta": 0, "period": 0, "dir_flag": 0, "delta": 0}
+    d = np.sign(et.step)
+    chg = np.concatenate([[0], np.cumsum(d[1:] != d[:-1])]) if d.size else np.zeros(0)
     for i in range(1, len(reads)):
         if jsel[i] >= 0 and jsel[i - 1] >= 0:
             checked["edge_delta"] += 1
@@ -700,6 +716,8 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
             checked["period"] += 1
             want_p = (et.t_s[p_to[i]] - et.t_s[p_from[i]]) / tick
             bad_period += abs(snaps[i].period - want_p) > 2
+            checked["dir_flag"] += 1
+            bad_dir += snaps[i].period_dir_change != int(chg[p_to[i]] > chg[p_from[i]])
     # SNAP_DELTA against the model's steps between the latching clocks (edges seen med ticks late),
     # where no step is within 4 clocks of either latch
     seen = et.t_s + med * tick
@@ -711,10 +729,14 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
         checked["delta"] += 1
         want = int((et.pos[n_at[i] - 1] if n_at[i] else 0) - (et.pos[n_at[i - 1] - 1] if n_at[i - 1] else 0))
         bad_delta += snaps[i].delta != want
-    true_t = np.abs(true_rpm(build_profile(case["profile"]), t_latch - med * tick))
-    true = case["rpm"] * DETUNE
+    true_s = true_rpm(build_profile(case["profile"]), t_latch - med * tick)
+    last_dir = np.where(n_at > 0, np.sign(et.step[np.maximum(n_at - 1, 0)]), 0)
+    true_t = np.abs(true_s)
+    # relative to: the speed (constant, ramp) or the top speed (reversal, which passes 0)
+    denom = np.full(len(reads), case["rpm"] * DETUNE) if case["kind"] == "constant" else (
+        np.maximum(true_t, 1e-9) if case["kind"] == "ramp" else np.full(len(reads), true_t.max()))
     res = {"unit": case["unit"], "rpm": case["rpm"], "edge": edge, "reads": len(reads),
-           "kind": case["kind"],
+           "kind": case["kind"], "bad_dir": bad_dir,
            "unmatched": unmatched, "bad_edge_delta": bad_edge_delta, "bad_period": bad_period,
            "bad_delta": bad_delta, "checked": checked, "latency_ticks": med,
            "period_newer": period_newer, "methods": {}}
@@ -744,12 +766,16 @@ def analyse_case(case, raw, args, tb, bits) -> dict:
         if not use.any():
             res["methods"][meth] = {"n": 0}
             continue
+        hr, fr = h, f                       # estimate() gives rpm
+        told = last_dir == np.sign(true_s)  # the encoder has shown the direction
+        moving = use & (true_t >= GOAL_NONZERO_RPM) & told
         res["methods"][meth] = {
             "n": int(use.sum()),
-            "added_max": float(np.max(np.abs(h[use] - f[use])) / true),
-            "err_max": float(np.max(np.abs(h[use] - true)) / true),
-            "floor_max": float(np.max(np.abs(f[use] - true)) / true),
-            "zeros": int(np.sum(h[use] == 0))}
+            "added_max": float(np.max(np.abs(hr[use] - fr[use]) / denom[use])),
+            "err_max": float(np.max(np.abs(hr[use] - true_s[use]) / denom[use])),
+            "floor_max": float(np.max(np.abs(fr[use] - true_s[use]) / denom[use])),
+            "zeros": int(np.sum(h[use] == 0)),
+            "wrong_sign": int(np.sum(moving & (hr * true_s < 0)))}
     return res
 
 
@@ -777,9 +803,12 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
          f"the units *{'*, *'.join(n for n, _ in units[:SIM_UNITS])}* at each speed, a few 1 kHz "
          "reads each (the first initialises, the first new edge is a reference). *Added*: max "
          "|reading from the simulated registers − the same estimator on the model's exact times "
-         "of the same edges| / true speed, over the reads with a measurement. *Checks*: "
-         "SNAP_EDGE_DELTA against the model's count between the matched edges, PERIOD against "
-         "the model's time between them (±2 ticks), SNAP_DELTA against the model's steps "
+         "of the same edges| / true speed (the reversal: / its top speed), over the reads with a "
+         "measurement; *wrong sign* = M/T readings against the shaft's direction where |speed| ≥ "
+         "6 rpm and the last count step already went that way. *Checks*: SNAP_EDGE_DELTA against the model's count between the matched edges, "
+         "PERIOD against the model's time between them (±2 ticks), PERIOD_CTRL.DIR_CHANGE "
+         "against a direction change among the model's steps they span, SNAP_DELTA against the "
+         "model's steps "
          "between the latching clocks (reads with no step within 4 clocks of a latch); "
          "*unmatched* = SNAP_EDGE_TIME values matching no model edge; *edge latency* = median "
          "SNAP_EDGE_TIME minus the pin time of its edge, in ticks (the synchroniser, the "
@@ -792,9 +821,9 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
     if errors:
         L += [f"**Simulation errors**: {'; '.join(errors.values())}", ""]
     L += ["| unit | rpm | edges | reads | M/T added max (%) | T added max (%) | M added max (%) "
-          "| M/T error max (%) | zeros M/T | checks failed (edge Δ / period / Δ of checked) "
-          "| unmatched | edge latency (ticks) | PERIOD newer |",
-          "|---|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|"]
+          "| M/T error max (%) | zeros M/T | wrong sign M/T | checks failed (edge Δ / period / "
+          "dir flag / Δ, of checked) | unmatched | edge latency (ticks) | PERIOD newer |",
+          "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|"]
     points = []
     stops = [r for r in results if r["kind"] == "stop"]
     results = [r for r in results if r["kind"] != "stop"]
@@ -803,14 +832,17 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
         mt, t = m.get("MT", {}), m.get("T", {})
         mm = m.get("M", {})
         ck = r["checked"]
-        L.append(f"| {r['unit']} | {r['rpm']:g} | {'A↑' if r['edge'] == 'a_rising' else 'any'} | "
+        label = {"constant": f"{r['rpm']:g}", "ramp": "ramp 600 → 3000 in 8 ms",
+                 "reversal": "150 → −150 in 16 ms"}[r["kind"]]
+        L.append(f"| {r['unit']} | {label} | {'A↑' if r['edge'] == 'a_rising' else 'any'} | "
                  f"{r['reads']} | {fmt_pct(mt.get('added_max'), 4)} ({mt.get('n', 0)}) | "
                  f"{fmt_pct(t.get('added_max'), 4)} | {fmt_pct(mm.get('added_max'), 4)} | "
                  f"{fmt_pct(mt.get('err_max'), 3)} | {mt.get('zeros', 0)} | "
+                 f"{mt.get('wrong_sign', 0)} | "
                  f"{r['bad_edge_delta']}/{ck['edge_delta']}, {r['bad_period']}/{ck['period']}, "
-                 f"{r['bad_delta']}/{ck['delta']} | {r['unmatched']} | "
-                 f"{r['latency_ticks']:.1f} | {r['period_newer']} |")
-        if r["edge"] == "a_rising" and mt.get("n"):
+                 f"{r['bad_dir']}/{ck['dir_flag']}, {r['bad_delta']}/{ck['delta']} | "
+                 f"{r['unmatched']} | {r['latency_ticks']:.1f} | {r['period_newer']} |")
+        if r["edge"] == "a_rising" and mt.get("n") and r["kind"] == "constant":
             points.append({"rpm": r["rpm"], "unit": r["unit"], "added_max": mt["added_max"]})
     L.append("")
     if stops:
@@ -832,7 +864,8 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
                      f"{m.get('MT', {}).get('moving_zeros', 0)} |")
         L.append("")
     goals_ = []
-    band = [r for r in results if r["edge"] == "a_rising" and GOAL_BAND[0] <= r["rpm"] <= GOAL_BAND[1]]
+    band = [r for r in results if r["edge"] == "a_rising" and r["kind"] == "constant"
+            and GOAL_BAND[0] <= r["rpm"] <= GOAL_BAND[1]]
     for label, sel, lim in (("non-ideal", [r for r in band if r["unit"] != "ideal"], GOAL_ADDED_TYP),
                             ("ideal", [r for r in band if r["unit"] == "ideal"], GOAL_ADDED_IDEAL)):
         vals = [r["methods"]["MT"]["added_max"] for r in sel if r["methods"].get("MT", {}).get("n")]
@@ -846,8 +879,18 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
                           f"(goal ≤ {100 * lim:g} %)"
                           + (f"; no measurement in the window at {', '.join(nomeas)} rpm" if nomeas else "")
                           + ".")
-    nbad = sum(r["bad_edge_delta"] + r["bad_period"] + r["bad_delta"] + r["unmatched"] for r in results)
-    nchk = sum(sum(r["checked"].values()) for r in results)
+    nbad = sum(r["bad_edge_delta"] + r["bad_period"] + r["bad_delta"] + r["bad_dir"]
+               + r["unmatched"] for r in results + stops)
+    nchk = sum(sum(r["checked"].values()) for r in results + stops)
+    for r in results:
+        if r["kind"] in ("ramp", "reversal") and r["methods"].get("MT", {}).get("n"):
+            mt = r["methods"]["MT"]
+            goals_.append(f"INFO (through the RTL): {r['kind']}, M/T "
+                          f"{'A↑' if r['edge'] == 'a_rising' else 'any edge'}: the registers add "
+                          f"at most {fmt_pct(mt['added_max'], 4)} % "
+                          f"{'of the top speed' if r['kind'] == 'reversal' else 'of the reading'}; "
+                          f"{mt['wrong_sign']} readings of the wrong sign, {mt['zeros']} of 0 "
+                          f"(of {mt['n']}).")
     goals_.append(f"{'MET' if nbad == 0 else 'MISSED'} (through the RTL): {nbad} inconsistencies "
                   f"between the latched registers and the model in {nchk} checks.")
     for r in stops:
@@ -1015,9 +1058,10 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
                 continue
             L += [f"**{SCENARIOS[sname][1]}**: rms / max error (%) where |true| ≥ 30 rpm "
                   "(against the speed at the read; the methods' lag included), readings of the "
-                  "wrong sign and of 0 where |true| ≥ 6 rpm (after a turn, a reading keeps the "
-                  "old sign, decaying, until the first count step back: the encoder has not "
-                  "said anything yet).", "",
+                  "wrong sign and of 0 where |true| ≥ 6 rpm. Wrong sign counts only readings "
+                  "after the encoder's last count step went the right way: between a turn and "
+                  "the first step back a reading keeps the old sign, decaying, as the encoder "
+                  "has not said anything yet.", "",
                   "| unit | " + " | ".join(LABEL[v] for v in VARIANTS) + " |",
                   "|---|" + "---|" * len(VARIANTS)]
             for n, _ in units:
