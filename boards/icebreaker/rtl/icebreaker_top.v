@@ -2,20 +2,30 @@
 // icebreaker_top -- the encoder interface on a 1BitSquared iCEBreaker (iCE40UP5K-SG48, 12 MHz).
 //
 // A HEDS-5000 on PMOD1A drives the library's blocks side by side:
-//   enc_a/enc_b -> enc_conditioner -> enc_x4_decoder -> POS_WIDTH-bit signed 4X position counter
-//                                  -> enc_phase_meter (Figure 11): red LED = A leads, green = B
+//   enc_a/enc_b/enc_i -> enc_qei_wb (the QEI peripheral: FUNC x4, RANGE free, COUNT_W =
+//                  POS_WIDTH, so COUNT_LO is the POS_WIDTH-bit two's complement 4X position), read
+//                  over Wishbone by a small master in this top, the way firmware would
+//   enc_a/enc_b -> enc_conditioner -> enc_phase_meter (Figure 11): red LED = A leads, green = B
 //   enc_a/enc_b -> enc_updown_buffer (Figure 17: its own conditioner, 2X XOR, four 'LS168 BCD
 //                  stages), read through rd_data with `hold` up for the whole report line, the
 //                  way a microprocessor reads an HCTL-2016.
+// The Wishbone master (B4 classic, one access at a time) writes CTRL once after reset (EN = 1,
+// FUNC = x4, RANGE = free, FILTER_LEN = this top's FILTER_LEN), then at the start of every report
+// line reads COUNT_LO, reads EVENTS and writes back to EVENTS the QERR, GLITCH and INDEX bits it
+// read (write 1 to clear: an event arriving between the read and the write stays pending for the
+// next line). An access ends with wb_ack_o or wb_err_o (an error reads 0; none is expected, the
+// offsets are mapped).
 // LINE_HZ times a second (default 10) a line goes out on the FTDI serial port (115200 8N1):
 //   P=+0001234 B=0617 PH=-001.25 F=EGI<CR><LF>
-//   P   4X position, signed decimal (sign and ND digits: 7 for POS_WIDTH = 24)
+//   P   4X position (COUNT_LO), signed decimal (sign and ND digits: 7 for POS_WIDTH = 24)
 //   B   the 2X BCD buffer (4 digits, counts modulo 10000)
 //   PH  the phase meter's last reading, phase - 90 degrees, in degrees with two decimals
 //       ("the phase meter reads zero at the adjustment point"; 0 until the first window ends)
-//   F   flags since the previous line, '-' when clear: E = illegal transition (4X count may be
-//       wrong), G = glitch rejected by the conditioner, I = index pulse seen
-// Position and phase are sampled at the start of the line; B is frozen by `hold` at that moment.
+//   F   the peripheral's events since the previous line, '-' when clear: E = EVENTS.QERR
+//       (illegal transition, the 4X count may be wrong), G = EVENTS.GLITCH (a level rejected by
+//       the peripheral's input filter), I = EVENTS.INDEX (rising edge of the filtered index)
+// Phase is sampled and B frozen by `hold` at the start of the line; COUNT_LO and EVENTS are read
+// in the next few clocks (the bus accesses take 2 clocks each).
 //
 // Pins (boards/icebreaker/icebreaker.pcf): clk 35 (12 MHz oscillator), btn_n 10 (user button, reset
 // while pressed), tx 9 (FTDI channel B RX, i.e. the board's UART output), led_r_n 11 and
@@ -33,9 +43,9 @@ module icebreaker_top #(
     parameter integer CLK_HZ            = 12_000_000,  // clk frequency: >= 2 * BAUD
     parameter integer BAUD              = 115_200,     // UART bit rate (8N1)
     parameter integer LINE_HZ           = 10,          // report lines per second: 1 .. CLK_HZ/64
-    parameter integer FILTER_LEN        = 3,           // conditioner filter, 1 .. 16 (contract)
+    parameter integer FILTER_LEN        = 3,           // input filters and CTRL.FILTER_LEN, 1 .. 16
     parameter integer PHASE_WINDOW_LOG2 = 20,          // phase meter window 2^N clocks, 8 .. 24
-    parameter integer POS_WIDTH         = 24           // 4X position counter bits: 8 .. 31
+    parameter integer POS_WIDTH         = 24           // 4X position bits (enc_qei COUNT_W): 8 .. 31
 ) (
     input  wire clk,      // 12 MHz oscillator, pin 35
     input  wire btn_n,    // user button, active low: reset
@@ -116,12 +126,62 @@ module icebreaker_top #(
     rst_n_q <= por_done & ~btn_q[1];
   end
 
-  // ---- 4X path: conditioner, decoder, position counter -----------------------------------------
-  wire a, b, glitch, cond_valid;
-  wire cnt4, up4, err4;
-  reg signed [POS_WIDTH-1:0] pos_q;
-  localparam signed [POS_WIDTH-1:0] POS_ONE = 1;
+  // ---- QEI peripheral: the 4X position and the events ------------------------------------------
+  // enc_qei registers: byte offsets and bit positions from rtl/enc_qei.rdl (doc/enc_qei_regs.md);
+  // the board test checks every access against the compiled RDL.
+  localparam [7:0] QEI_CTRL = 8'h08;
+  localparam [7:0] QEI_COUNT_LO = 8'h10;
+  localparam [7:0] QEI_EVENTS = 8'h4C;
+  localparam integer CTRL_EN = 0;  // CTRL.EN
+  localparam integer CTRL_FUNC = 8;  // CTRL.FUNC, 4 bits: 0 = x4
+  localparam integer CTRL_RANGE = 12;  // CTRL.RANGE, 2 bits: 0 = free (wraps modulo 2^COUNT_W)
+  localparam integer CTRL_FILTER_LEN = 16;  // CTRL.FILTER_LEN, 5 bits
+  localparam integer EV_INDEX = 2;  // EVENTS.INDEX
+  localparam integer EV_QERR = 5;  // EVENTS.QERR
+  localparam integer EV_GLITCH = 6;  // EVENTS.GLITCH
+  localparam [31:0] FUNC_X4 = 32'd0;
+  localparam [31:0] RANGE_FREE = 32'd0;
+  localparam [31:0] FILTER_LEN32 = FILTER_LEN;
+  localparam [31:0] CTRL_WORD = (32'd1 << CTRL_EN) | (FUNC_X4 << CTRL_FUNC) |
+                                (RANGE_FREE << CTRL_RANGE) | (FILTER_LEN32 << CTRL_FILTER_LEN);
 
+  wire        wb_stb, wb_we, wb_ack, wb_err;
+  reg  [ 7:0] wb_adr;
+  reg  [31:0] wb_wdat;
+  /* verilator lint_off UNUSEDSIGNAL */  // the master keeps COUNT_LO[POS_WIDTH-1:0] and 3 event bits
+  wire [31:0] wb_rdat;
+  /* verilator lint_on UNUSEDSIGNAL */
+
+  /* verilator lint_off PINCONNECTEMPTY */
+  enc_qei_wb #(
+      .COUNT_W(POS_WIDTH),
+      .TS_W   (16)         // the timing unit is not used: its smallest width
+  ) u_qei (
+      .clk     (clk),
+      .rst     (rst),
+      .wb_adr_i(wb_adr),
+      .wb_dat_i(wb_wdat),
+      .wb_dat_o(wb_rdat),
+      .wb_sel_i(4'b1111),
+      .wb_we_i (wb_we),
+      .wb_stb_i(wb_stb),
+      .wb_cyc_i(wb_stb),
+      .wb_ack_o(wb_ack),
+      .wb_err_o(wb_err),
+      .a_in    (enc_a),
+      .b_in    (enc_b),
+      .z_in    (enc_i),
+      .probe_in(1'b0),
+      .snap_in (1'b0),
+      .irq     (),          // the events are polled once per line
+      .cmp_out ()
+  );
+  /* verilator lint_on PINCONNECTEMPTY */
+
+  // ---- conditioner for the phase meter -------------------------------------------------------------
+  wire a, b;
+
+  /* verilator lint_off PINCONNECTEMPTY */
   enc_conditioner #(
       .FILTER_LEN(FILTER_LEN)
   ) u_cond (
@@ -131,28 +191,10 @@ module icebreaker_top #(
       .b_in  (enc_b),
       .a     (a),
       .b     (b),
-      .glitch(glitch),
-      .valid (cond_valid)
+      .glitch(),       // the G flag is the peripheral's EVENTS.GLITCH
+      .valid ()        // the phase meter waits for its first window anyway
   );
-
-  // the decoder starts once the conditioner shows the real levels (its reference state)
-  enc_x4_decoder u_x4 (
-      .clk      (clk),
-      .rst      (rst | ~cond_valid),
-      .a        (a),
-      .b        (b),
-      .cnt_pulse(cnt4),
-      .up       (up4),
-      .error    (err4)
-  );
-
-  always @(posedge clk) begin
-    if (rst) begin
-      pos_q <= {POS_WIDTH{1'b0}};
-    end else if (cnt4) begin
-      pos_q <= up4 ? pos_q + POS_ONE : pos_q - POS_ONE;
-    end
-  end
+  /* verilator lint_on PINCONNECTEMPTY */
 
   // ---- 2X BCD buffer (Figure 17) ----------------------------------------------------------------
   reg                     hold_q;
@@ -205,14 +247,6 @@ module icebreaker_top #(
   assign led_r_n = ~a_leads;
   assign led_g_n = ~b_leads;
 
-  // ---- index input and sticky flags --------------------------------------------------------------
-  reg [2:0] idx_q;  // synchronizer (2 stages) + previous level
-  always @(posedge clk) begin
-    if (rst) idx_q <= 3'b000;
-    else idx_q <= {idx_q[1:0], enc_i};
-  end
-  wire idx_rise = idx_q[1] & ~idx_q[2];
-
   // ---- line timer --------------------------------------------------------------------------------
   reg [LW-1:0] tick_q;
   reg          line_req_q;  // a line is due
@@ -224,7 +258,7 @@ module icebreaker_top #(
   end
 
   // ---- report sequencer ---------------------------------------------------------------------------
-  localparam [1:0] S_IDLE = 2'd0, S_CONV = 2'd1, S_SEND = 2'd2;
+  localparam [1:0] S_IDLE = 2'd0, S_BUS = 2'd1, S_CONV = 2'd2, S_SEND = 2'd3;
 
   reg [1:0] st_q, st_d;
   reg [5:0] ci_q, ci_d;  // template index of the character being sent
@@ -233,11 +267,77 @@ module icebreaker_top #(
   reg [4*NDC-1:0] bcd_q, bcd_d;
   reg [5:0] conv_n_q, conv_n_d;  // shifts left
   reg line_req_d, hold_d;
-  // snapshot taken at the start of a line
-  reg pos_neg_q, pos_neg_d, ph_neg_q, ph_neg_d;
-  reg [HW-1:0] ph_mag_q, ph_mag_d;  // the position goes straight into the converter
-  reg err_q, err_d, gl_q, gl_d, ix_q, ix_d;  // flags since the last snapshot
-  reg [2:0] fl_q, fl_d;  // {I, G, E} of this line
+  // phase snapshot taken at the start of a line (the position and flags are the master's reads)
+  reg ph_neg_q, ph_neg_d;
+  reg [HW-1:0] ph_mag_q, ph_mag_d;
+
+  // ---- Wishbone master: the firmware's part ----------------------------------------------------------
+  // After reset: CTRL <= CTRL_WORD. Per line (the sequencer waits in S_BUS): cnt = COUNT_LO;
+  // ev = EVENTS; EVENTS <= ev & (QERR | GLITCH | INDEX). cyc = stb for the whole access; each
+  // access holds its address and data until wb_ack / wb_err, and the next one starts in the
+  // following clock.
+  localparam [2:0] M_CTRL = 3'd0, M_IDLE = 3'd1, M_CNT = 3'd2, M_EVR = 3'd3, M_EVW = 3'd4;
+
+  reg [2:0] m_q, m_d;
+  reg [POS_WIDTH-1:0] cnt_q, cnt_d;  // COUNT_LO of this line: the 4X position
+  reg [2:0] ev_q, ev_d;  // {INDEX, GLITCH, QERR} read from EVENTS for this line
+  wire wb_end = wb_ack | wb_err;
+  wire bus_done = (m_q == M_EVW) & wb_end;  // the line's reads and the clear are done
+
+  assign wb_stb = (m_q != M_IDLE);
+  assign wb_we  = (m_q == M_CTRL) | (m_q == M_EVW);
+
+  always @(*) begin
+    m_d     = m_q;
+    cnt_d   = cnt_q;
+    ev_d    = ev_q;
+    wb_adr  = QEI_EVENTS;
+    wb_wdat = 32'd0;
+    case (m_q)
+      M_CTRL: begin
+        wb_adr  = QEI_CTRL;
+        wb_wdat = CTRL_WORD;
+        if (wb_end) m_d = M_IDLE;
+      end
+      M_IDLE: begin
+        if (st_q == S_BUS) m_d = M_CNT;
+      end
+      M_CNT: begin
+        wb_adr = QEI_COUNT_LO;
+        if (wb_end) begin
+          cnt_d = wb_rdat[POS_WIDTH-1:0];
+          m_d   = M_EVR;
+        end
+      end
+      M_EVR: begin
+        if (wb_end) begin
+          ev_d = {wb_rdat[EV_INDEX], wb_rdat[EV_GLITCH], wb_rdat[EV_QERR]};
+          m_d  = M_EVW;
+        end
+      end
+      default: begin  // M_EVW: write 1 to clear what was read
+        wb_wdat[EV_INDEX]  = ev_q[2];
+        wb_wdat[EV_GLITCH] = ev_q[1];
+        wb_wdat[EV_QERR]   = ev_q[0];
+        if (wb_end) m_d = M_IDLE;
+      end
+    endcase
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      m_q  <= M_CTRL;
+      ev_q <= 3'b000;
+    end else begin
+      m_q  <= m_d;
+      ev_q <= ev_d;
+    end
+  end
+
+  // read before it is shown on every line: no reset needed
+  always @(posedge clk) begin
+    cnt_q <= cnt_d;
+  end
 
   // phase in 1/100 degree: |phase_err| * 100 / 256, rounded
   wire        ph_neg = phase_q[15];
@@ -246,8 +346,8 @@ module icebreaker_top #(
   wire [21:0] ph_x25 = {6'd0, ph_abs} * 22'd25 + 22'd32;
   /* verilator lint_on UNUSEDSIGNAL */
   wire [HW-1:0] ph_hund = ph_x25[6+HW-1:6];
-  wire        pos_neg = pos_q[POS_WIDTH-1];
-  wire [POS_WIDTH-1:0] pos_abs = (pos_q ^ {POS_WIDTH{pos_neg}}) + {{(POS_WIDTH - 1) {1'b0}}, pos_neg};
+  wire        pos_neg = cnt_q[POS_WIDTH-1];  // COUNT_LO as a POS_WIDTH-bit signed number
+  wire [POS_WIDTH-1:0] pos_abs = (cnt_q ^ {POS_WIDTH{pos_neg}}) + {{(POS_WIDTH - 1) {1'b0}}, pos_neg};
 
   // the two numbers, zero-extended to the converter width
   wire [CW-1:0] pos_mag_cw, ph_mag_cw;
@@ -296,7 +396,7 @@ module icebreaker_top #(
     end else if (in_buf) begin
       ch = {4'h3, buf_dig};
     end else if (ci == T_PSIGN) begin
-      ch = pos_neg_q ? "-" : "+";
+      ch = pos_neg ? "-" : "+";
     end else if (ci == T_HSIGN) begin
       ch = ph_neg_q ? "-" : "+";
     end else if (ci == T_HDIG + 3) begin
@@ -314,11 +414,11 @@ module icebreaker_top #(
     end else if (ci == T_F + 1) begin
       ch = "F";
     end else if (ci == T_FLAGS) begin
-      ch = fl_q[0] ? "E" : "-";
+      ch = ev_q[0] ? "E" : "-";
     end else if (ci == T_FLAGS + 1) begin
-      ch = fl_q[1] ? "G" : "-";
+      ch = ev_q[1] ? "G" : "-";
     end else if (ci == T_FLAGS + 2) begin
-      ch = fl_q[2] ? "I" : "-";
+      ch = ev_q[2] ? "I" : "-";
     end else if (ci == T_FLAGS + 3) begin
       ch = 8'h0d;
     end else if (ci == T_LAST) begin
@@ -341,13 +441,8 @@ module icebreaker_top #(
     conv_n_d   = conv_n_q;
     line_req_d = line_req_q | tick;
     hold_d     = hold_q;
-    pos_neg_d  = pos_neg_q;
     ph_neg_d   = ph_neg_q;
     ph_mag_d   = ph_mag_q;
-    fl_d       = fl_q;
-    err_d      = err_q | err4;
-    gl_d       = gl_q | glitch;
-    ix_d       = ix_q | idx_rise;
     tx_valid   = 1'b0;
     case (st_q)
       S_IDLE: begin
@@ -356,17 +451,17 @@ module icebreaker_top #(
           hold_d     = 1'b1;
           ci_d       = 6'd0;
           conv_ok_d  = 1'b0;
-          pos_neg_d  = pos_neg;
-          sh_d       = pos_mag_cw;  // convert the position right away
-          bcd_d      = {4 * NDC{1'b0}};
-          conv_n_d   = CW[5:0];
           ph_neg_d   = ph_neg;
           ph_mag_d   = ph_hund;
-          fl_d       = {ix_q, gl_q, err_q};
-          err_d      = err4;  // an event in this very clock counts for the next line
-          gl_d       = glitch;
-          ix_d       = idx_rise;
-          st_d       = S_CONV;
+          st_d       = S_BUS;  // the master reads COUNT_LO and EVENTS
+        end
+      end
+      S_BUS: begin
+        if (bus_done) begin
+          sh_d     = pos_mag_cw;  // convert the position right away
+          bcd_d    = {4 * NDC{1'b0}};
+          conv_n_d = CW[5:0];
+          st_d     = S_CONV;
         end
       end
       S_CONV: begin
@@ -411,20 +506,12 @@ module icebreaker_top #(
       conv_ok_q  <= 1'b0;
       line_req_q <= 1'b0;
       hold_q     <= 1'b0;
-      err_q      <= 1'b0;
-      gl_q       <= 1'b0;
-      ix_q       <= 1'b0;
-      fl_q       <= 3'b000;
     end else begin
       st_q       <= st_d;
       ci_q       <= ci_d;
       conv_ok_q  <= conv_ok_d;
       line_req_q <= line_req_d;
       hold_q     <= hold_d;
-      err_q      <= err_d;
-      gl_q       <= gl_d;
-      ix_q       <= ix_d;
-      fl_q       <= fl_d;
     end
   end
 
@@ -434,7 +521,6 @@ module icebreaker_top #(
     bcd_q     <= bcd_d;
     conv_n_q  <= conv_n_d;
     dig_q     <= dig_d;
-    pos_neg_q <= pos_neg_d;
     ph_neg_q  <= ph_neg_d;
     ph_mag_q  <= ph_mag_d;
   end

@@ -7,28 +7,41 @@ receiver decodes every line (framing checked), and the lines are checked against
 
 - quiet spells in a random walk (bursts of valid transitions, both directions, going negative):
   `P` equals the true 4X position and `B` the 2X count (p + 1) // 2 modulo 10000 in BCD;
-- flags: none during clean motion; a lone 100 ns glitch gives `G` in exactly one line, an index
-  pulse `I`, an illegal transition (both channels change) `E`, each on the next line only;
+- flags: none during clean motion; a lone 100 ns glitch and a 3.5-clock one (rejected only at the
+  board's FILTER_LEN = 5, counted at enc_qei's reset value 3) each give `G` in exactly one line,
+  an index pulse `I`, an illegal transition (both channels change) `E`, each on the next line only;
+- the position and the flags come from enc_qei over Wishbone: a monitor on the top's bus checks,
+  against the register map compiled from rtl/enc_qei.rdl, one CTRL write after each reset (EN,
+  FUNC = x4, RANGE = free, FILTER_LEN = the board's), then before every line a COUNT_LO read, an
+  EVENTS read and an EVENTS write of exactly the QERR/GLITCH/INDEX bits read (write 1 to clear),
+  and that the line shows that COUNT_LO (as a POS_WIDTH-bit signed number) and those bits;
 - Figure 11: steady rotation at 90 degrees lights the red LED forward and the green LED in reverse,
   and the `PH` field reads the phase minus 90 degrees (0.00 at 90, +10.00 at 100 degrees) to the
   contract's 0.25 degree accuracy;
 - the line cadence: one line per 0.5 ms.
+
+It runs twice: at POS_WIDTH = 24 (the default) and at POS_WIDTH = 8, where the walk and a
+monotone sweep of 4 x 70 counts wrap the counter, so `P` is checked as a POS_WIDTH-bit two's
+complement number on both sides of the wrap (the sign bit of COUNT_LO matters).
 """
 
 from __future__ import annotations
 
+import os
 import random
 import re
 
 import cocotb
+import pytest
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, FallingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from core_file import TOP, board_files
 from harness import run
 from cocotbext.quadrature import play
 from hedsmodel.waveform import QUAD, STATE_TO_POS, Waveform
+from qei_tb import addr, event_bits, extra_sources, get_field, pack
 from tbutil import log_seed
 
 CLK_HZ = 12_000_000
@@ -40,9 +53,12 @@ PHASE_WINDOW_LOG2 = 13  # 8192 clocks = 0.68 ms
 WINDOW_NS = (1 << PHASE_WINDOW_LOG2) * CLK_PS / 1000.0
 LINE_NS = 1e9 / LINE_HZ
 
+POS_WIDTH = int(os.environ.get("IB_POS_WIDTH", "24"))  # set by the pytest entry point
+FILTER_LEN = 5  # not enc_qei's CTRL.FILTER_LEN reset value (3): the top must write it
 PARAMS = {"CLK_HZ": CLK_HZ, "BAUD": BAUD, "LINE_HZ": LINE_HZ, "PHASE_WINDOW_LOG2": PHASE_WINDOW_LOG2,
-          "POS_WIDTH": 24, "FILTER_LEN": 3}
-ND = 7  # decimal digits of 2^23
+          "POS_WIDTH": POS_WIDTH, "FILTER_LEN": FILTER_LEN}
+ND = len(str(1 << (POS_WIDTH - 1)))  # decimal digits of the largest magnitude (7 for 24 bits)
+FLAG_EVENTS = {"E": "QERR", "G": "GLITCH", "I": "INDEX"}  # line flag -> enc_qei EVENTS field
 
 LINE_RE = re.compile(r"^P=([+-]\d{%d}) B=(\d{4}) PH=([+-]\d{3}\.\d{2}) F=([E-])([G-])([I-])\r\n$" % ND)
 
@@ -84,6 +100,59 @@ def parse(text: str) -> dict:
 
 
 # ------------------------------------------------------------------------------------------------
+# Wishbone monitor (the top's master and enc_qei_wb)
+# ------------------------------------------------------------------------------------------------
+async def wb_monitor(dut, txns: list) -> None:
+    """Append (time in ns, write, byte address, data) for every access that ends; data is the
+    written word for a write, the read word for a read. Asserts that none ends in wb_err."""
+    while True:
+        await RisingEdge(dut.clk)
+        if not dut.wb_stb.value.is_resolvable:  # before the first clock of the power-on reset
+            continue
+        if int(dut.wb_stb.value) and (int(dut.wb_ack.value) or int(dut.wb_err.value)):
+            adr = int(dut.wb_adr.value)
+            assert not int(dut.wb_err.value), f"Wishbone error at offset {adr:#04x}"
+            we = bool(int(dut.wb_we.value))
+            data = int((dut.wb_wdat if we else dut.wb_rdat).value)
+            txns.append((get_sim_time(unit="ns"), we, adr, data))
+
+
+def check_bus(parsed: list, txns: list, t_base: float) -> int:
+    """The firmware's part: one CTRL write after each reset, then per line COUNT_LO read, EVENTS
+    read, EVENTS write of the flag bits read; the line shows what was read. Times in ``parsed``
+    are from t_base (the start of playback), in ``txns`` absolute. Returns the lines checked."""
+    flag_mask = event_bits(*FLAG_EVENTS.values())
+    ctrl = pack("CTRL", EN=1, FUNC="x4", RANGE="free", FILTER_LEN=FILTER_LEN)
+    pos_mask = (1 << POS_WIDTH) - 1
+    t_ctrl = [t for t, we, a, _ in txns if we and a == addr("CTRL")]
+    assert len(t_ctrl) == 2, f"CTRL written at {t_ctrl} ns: expected once after power-on and once " \
+                             f"after the button reset"
+    for t, we, a, d in txns:
+        if we and a == addr("CTRL"):
+            assert d == ctrl, f"CTRL written {d:#010x}, expected {ctrl:#010x} (EN, x4, free, FILTER_LEN={FILTER_LEN})"
+    accesses = [x for x in txns if x[0] > t_ctrl[-1]]
+    k = 0
+    t_prev = t_ctrl[-1]
+    for t_line, text, f in parsed:
+        seq = [x for x in accesses if t_prev < x[0] < t_line + t_base]
+        t_prev = t_line + t_base
+        assert [(we, a) for _, we, a, _ in seq] == [(False, addr("COUNT_LO")), (False, addr("EVENTS")),
+                                                    (True, addr("EVENTS"))], \
+            f"line at {t_line:.0f} ns: bus accesses before it {[(hex(a), we) for _, we, a, _ in seq]}"
+        cnt, ev, clr = seq[0][3], seq[1][3], seq[2][3]
+        assert cnt & ~pos_mask == 0, f"COUNT_LO {cnt:#x} has bits above COUNT_W = {POS_WIDTH}"
+        p = cnt - (1 << POS_WIDTH) if cnt >> (POS_WIDTH - 1) else cnt
+        assert f["p"] == p, f"line at {t_line:.0f} ns: P={f['p']} but COUNT_LO read {cnt:#x} ({p}): {text!r}"
+        for flag, field in FLAG_EVENTS.items():
+            assert f[flag] == bool(get_field("EVENTS", field, ev)), \
+                f"line at {t_line:.0f} ns: flag {flag} = {f[flag]} but EVENTS read {ev:#x}: {text!r}"
+        assert clr == ev & flag_mask, f"line at {t_line:.0f} ns: EVENTS read {ev:#x}, cleared {clr:#x}, " \
+                                      f"expected {ev & flag_mask:#x}"
+        k += 1
+    return k
+
+
+# ------------------------------------------------------------------------------------------------
 # stimulus
 # ------------------------------------------------------------------------------------------------
 class Session:
@@ -95,7 +164,7 @@ class Session:
         self.pos = 0
         self.wf.append(0.0, 0)
         self.quiet = []  # (t_from, t_to, pos): the input holds `pos` all this time
-        self.marks = {}  # name -> time of a glitch / index / illegal transition
+        self.marks = []  # (flag, time) of each glitch / index / illegal transition
         self.steady = []  # (t_from, t_to, phase_deg, forward)
 
     def step(self, d: int, dur: float) -> None:
@@ -115,7 +184,7 @@ class Session:
         """A lone pulse on A in the middle of a quiet spell; the position does not change."""
         a, b = QUAD[self.pos % 4]
         self.pause(50_000.0)
-        self.marks["glitch"] = self.t
+        self.marks.append(("G", self.t))
         self.wf.append(self.t, self.pos, (1 - a, b))
         self.wf.append(self.t + width_ns, self.pos, (a, b))
         self.t += width_ns
@@ -152,7 +221,7 @@ class Session:
 
     def illegal(self) -> None:
         self.pause(50_000.0)
-        self.marks["illegal"] = self.t
+        self.marks.append(("E", self.t))
         a, b = QUAD[self.pos % 4]
         self.wf.append(self.t, None, (1 - a, 1 - b))  # both channels at once: position unknown
         self.t += 2 * LINE_NS  # not a quiet spell to check: the 2X buffer counted the A edge
@@ -177,6 +246,8 @@ async def board_session(dut):
     dut.enc_b.value = 0
     dut.enc_i.value = 0
     dut.btn_n.value = 1
+    txns: list = []
+    cocotb.start_soon(wb_monitor(dut, txns))
     cocotb.start_soon(Clock(dut.clk, CLK_PS, unit="ps").start())
     await ClockCycles(dut.clk, 30)  # power-on reset (16 clocks)
     assert int(dut.tx.value) == 1, "UART line not idle after power-on reset"
@@ -190,9 +261,15 @@ async def board_session(dut):
     for bias in (-1, -1, -1, 1, 1, 1, 1, 1, -1, 1, -1, 1):
         s.burst(rng, rng.randrange(60, 160), bias)
         s.pause(LINE_NS * 1.3 + rng.uniform(0, LINE_NS))
-    s.glitch(100.0)  # 1.2 clocks: sampled once or twice, under FILTER_LEN = 3
+    for _ in range(4):  # quiet spells 70 counts apart: one is on each side of any sign boundary
+        for _ in range(70):
+            s.step(1, rng.uniform(500.0, 1500.0))
+        s.pause(LINE_NS * 1.3 + rng.uniform(0, LINE_NS))
+    s.glitch(100.0)  # 1.2 clocks: sampled once or twice, rejected at any FILTER_LEN >= 3
+    s.glitch(3.5 * CLK_PS / 1000.0)  # sampled 3 or 4 times: rejected at 5, counted at 3
     s.pause(50_000.0)
-    s.marks["index"] = s.t
+    s.marks.append(("I", s.t))
+    t_index = s.t
     s.pause(2 * LINE_NS)
     seg = []
     for phase, forward in ((90.0, True), (100.0, True), (90.0, False)):
@@ -204,7 +281,7 @@ async def board_session(dut):
     lines: list = []
     cocotb.start_soon(uart_receiver(dut, lines))
     t_base = get_sim_time(unit="ns")
-    cocotb.start_soon(index_pulse(dut, s.marks["index"], 2_000.0))
+    cocotb.start_soon(index_pulse(dut, t_index, 2_000.0))
 
     # play the waveform, checking the LEDs at the end of each steady segment
     led_checks = []
@@ -236,27 +313,39 @@ async def board_session(dut):
     gaps = [b[0] - a[0] for a, b in zip(parsed, parsed[1:])]
     assert all(abs(g - LINE_NS) < 2_000.0 for g in gaps), f"line cadence off: {min(gaps)}..{max(gaps)} ns"
 
+    def wrap(p: int) -> int:  # the POS_WIDTH-bit counter's signed value
+        half = 1 << (POS_WIDTH - 1)
+        return (p + half) % (2 * half) - half
+
     checked = 0
     for t, text, f in parsed:
         for q_from, q_to, pos in s.quiet:
             if q_from + QUIET_NS <= t <= q_to:
-                assert f["p"] == pos, f"line at {t:.0f} ns: P={f['p']} but the shaft is at {pos}: {text!r}"
+                assert f["p"] == wrap(pos), f"line at {t:.0f} ns: P={f['p']} but the shaft is at {pos} " \
+                                            f"({wrap(pos)} in {POS_WIDTH} bits): {text!r}"
                 exp_b = ((pos + 1) // 2) % 10000
                 assert f["b"] == exp_b, f"line at {t:.0f} ns: B={f['b']:04d}, expected {exp_b:04d} " \
                                         f"(2X count of 4X position {pos}): {text!r}"
                 checked += 1
     assert checked >= 12, f"only {checked} lines fell in quiet spells"
     assert min(p for _, _, p in s.quiet) < 0, "the walk should have gone negative"
+    if POS_WIDTH <= 8:
+        assert any(wrap(p) != p for _, _, p in s.quiet), "the counter should have wrapped"
 
-    # each flag: set on exactly one line, the first after its event (or the second, if the
-    # first started before the event reached the snapshot)
-    for flag, mark in (("G", "glitch"), ("I", "index"), ("E", "illegal")):
-        t_ev = s.marks[mark]
+    # each flag: set on exactly one line per event, the first after it (or the second, if the
+    # first started before the event reached EVENTS)
+    for flag in FLAG_EVENTS:
+        t_evs = [t for fl, t in s.marks if fl == flag]
         hits = [t for t, _, f in parsed if f[flag]]
-        after = [t for t, _, _ in parsed if t > t_ev]
-        assert len(hits) == 1, f"flag {flag}: set on {len(hits)} lines (at {hits}), expected one after {mark}"
-        assert hits[0] in after[:2] and (hits[0] == after[0] or after[0] - t_ev < 5_000.0), \
-            f"flag {flag} on the line at {hits[0]:.0f} ns, {mark} was at {t_ev:.0f} ns"
+        assert len(hits) == len(t_evs), \
+            f"flag {flag}: set on {len(hits)} lines (at {hits}), expected one after each event at {t_evs}"
+        for t_ev, hit in zip(t_evs, hits):
+            after = [t for t, _, _ in parsed if t > t_ev]
+            assert hit in after[:2] and (hit == after[0] or after[0] - t_ev < 5_000.0), \
+                f"flag {flag} on the line at {hit:.0f} ns, its event was at {t_ev:.0f} ns"
+
+    # ---- the readout is enc_qei's, over Wishbone -------------------------------------------------
+    n_bus = check_bus(parsed, txns, t_base)
 
     # phase readings: lines at least two windows into a steady segment
     for t_from, t_to, phase, forward in seg:
@@ -265,12 +354,16 @@ async def board_session(dut):
         for v in ph:
             assert abs(v - (phase - 90.0)) <= 0.26, \
                 f"steady {phase} deg {'forward' if forward else 'reverse'}: PH={v:+.2f}, expected {phase - 90.0:+.2f}"
-    dut._log.info("checked %d exact position lines, flags G/I/E, %d phase segments", checked, len(seg))
+    dut._log.info("checked %d exact position lines, flags G/I/E, %d phase segments, %d lines against "
+                  "the bus", checked, len(seg), n_bus)
 
 
 # ------------------------------------------------------------------------------------------------
 # pytest entry point
 # ------------------------------------------------------------------------------------------------
-def test_icebreaker_top():
-    run("icebreaker_top", "test_icebreaker_top", name="icebreaker_top", parameters=PARAMS,
-        extra_sources=tuple(TOP / f for f in board_files("icebreaker")))
+@pytest.mark.parametrize("pos_width", [24, 8])
+def test_icebreaker_top(pos_width):
+    # enc_qei's files come from the core's rtl fileset; extra_sources() adds any it lacks
+    run("icebreaker_top", "test_icebreaker_top", name=f"icebreaker_top_w{pos_width}",
+        parameters={**PARAMS, "POS_WIDTH": pos_width}, extra_env={"IB_POS_WIDTH": str(pos_width)},
+        extra_sources=extra_sources() + tuple(TOP / f for f in board_files("icebreaker")))
