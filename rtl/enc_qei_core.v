@@ -13,8 +13,9 @@
 //   backward (-1); x1b the same on B; pulse_dir / increase / decrease: rising edges of A (B = up).
 // Count priority in one clock: COUNT write > index preset > count step. Range modes: free,
 // modulo (0 .. CEILING), limit (stops at 0 / CEILING), non_recycle (stops until COUNT is
-// written). Every decoder output has latency 1 from its sample; the index and probe edge
-// detectors are registered the same way, so all act in the clock of the transition they see.
+// written). Every decoder output has latency 1 from its sample and the count step one more
+// register; the index edge detector is delayed the same, so an index acts in the clock of the
+// transition it sees.
 `default_nettype none
 
 module enc_qei_core #(
@@ -214,10 +215,28 @@ module enc_qei_core #(
     endcase
   end
 
-  assign step_up     = en & fup;
-  assign step_dn     = en & fdn;
-  assign edge_any    = x4_cnt;
-  assign edge_a_rise = x4_cnt & a_moved & a1_q;
+  // One register stage between the count function and the count (for Fmax): the steps, the
+  // edges and the index hit below are all delayed alike.
+  reg step_up_q, step_dn_q, edge_any_q, edge_a_rise_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      step_up_q     <= 1'b0;
+      step_dn_q     <= 1'b0;
+      edge_any_q    <= 1'b0;
+      edge_a_rise_q <= 1'b0;
+    end else begin
+      step_up_q     <= en & fup;
+      step_dn_q     <= en & fdn;
+      edge_any_q    <= x4_cnt;
+      edge_a_rise_q <= x4_cnt & a_moved & a1_q;
+    end
+  end
+
+  assign step_up     = step_up_q;
+  assign step_dn     = step_dn_q;
+  assign edge_any    = edge_any_q;
+  assign edge_a_rise = edge_a_rise_q;
   assign ev_qerr     = quad & x4_err;
 
   // ---- range ---------------------------------------------------------------------------------------
@@ -302,17 +321,19 @@ module enc_qei_core #(
   // Qualified index: Z and, with the gate, (A, B) = (GATE_A, GATE_B); the chosen edge of it acts.
   wire idx_q      = z_eff & (~idx_gate_en | ((a_eff == idx_gate_a) & (b_eff == idx_gate_b)));
   wire armed      = idx_arm & (idx_action != 2'd0);
-  reg  idx_prev_q, idx_ok_q, idx_hit_q;
+  reg  idx_prev_q, idx_ok_q, idx_hit1_q, idx_hit_q;
 
   always @(posedge clk) begin
     if (rst | ~valid) begin
       idx_prev_q <= 1'b0;
       idx_ok_q   <= 1'b0;
+      idx_hit1_q <= 1'b0;
       idx_hit_q  <= 1'b0;
     end else begin
       idx_prev_q <= idx_q;
       idx_ok_q   <= 1'b1;
-      idx_hit_q  <= idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+      idx_hit1_q <= idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+      idx_hit_q  <= idx_hit1_q;  // aligned with the step register above
     end
   end
 

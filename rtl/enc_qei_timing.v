@@ -9,7 +9,7 @@
 // the count register (`count`, which already includes the previous clock's step) with the edges
 // and steps up to that same point.
 // Snapshot: a request -- snap_cmd, a rising edge of snap_in while snap_in_en, or the unit timer
-// (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in that one clock:
+// (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in one clock (the next):
 //   SNAP_COUNT      the count register now (count)
 //   SNAP_TIME       the timebase now
 //   SNAP_EDGE_TIME  the timestamp of the last edge of the selected type (this clock's included)
@@ -119,22 +119,27 @@ module enc_qei_timing #(
   end
 
   // ---- snapshot ------------------------------------------------------------------------------------
-  reg  [TS_W-1:0] unit_q;        // ticks since the unit timer started
+  // unit timer: counts down from SNAP_PERIOD - 1 once per tick, snaps on the tick at 0
+  reg  [TS_W-1:0] unit_q;
   reg             snap_in_q;
-  wire [TS_W-1:0] unit_len = (snap_period == TS_ZERO) ? TS_ONE : snap_period;
-  wire            unit_hit = snap_period_en & tick & ((unit_q + TS_ONE) >= unit_len);
-  wire            snap_req = snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
+  wire [TS_W-1:0] unit_load = (snap_period == TS_ZERO) ? TS_ZERO : snap_period - TS_ONE;
+  wire            unit_hit  = snap_period_en & tick & (unit_q == TS_ZERO);
+  // the request is registered (Fmax): the snapshot is taken in the clock after it, all values
+  // of that one clock
+  reg             snap_req;
 
   always @(posedge clk) begin
     if (rst) begin
       unit_q    <= TS_ZERO;
       snap_in_q <= 1'b0;
+      snap_req  <= 1'b0;
     end else begin
       snap_in_q <= snap_in;
+      snap_req  <= snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
       if (~snap_period_en | unit_hit) begin
-        unit_q <= TS_ZERO;
+        unit_q <= unit_load;
       end else if (tick) begin
-        unit_q <= unit_q + TS_ONE;
+        unit_q <= unit_q - TS_ONE;
       end
     end
   end
@@ -238,20 +243,33 @@ module enc_qei_timing #(
   end
 
   // ---- stall ----------------------------------------------------------------------------------------
-  reg [TS_W-1:0] stall_q;
-  reg            stalled_q;
-  wire           stall_hit = (stall_timeout != TS_ZERO) & ~stalled_q & ~step_q & tick &
-                             ((stall_q + TS_ONE) >= stall_timeout);
+  // counts down from STALL_TIMEOUT - 1 once per tick after each step (or a change of
+  // STALL_TIMEOUT); the tick at 0 stalls
+  reg  [TS_W-1:0] stall_q;
+  reg  [TS_W-1:0] stall_timeout_q;
+  reg             stalled_q;
+  wire            stall_off = (stall_timeout == TS_ZERO);
+  wire            stall_new = (stall_timeout != stall_timeout_q);
+  wire            stall_hit = ~stall_off & ~stall_new & ~stalled_q & ~step_q & tick &
+                              (stall_q == TS_ZERO);
+
+  always @(posedge clk) begin
+    if (rst) begin
+      stall_timeout_q <= TS_ZERO;
+    end else begin
+      stall_timeout_q <= stall_timeout;
+    end
+  end
 
   always @(posedge clk) begin
     if (rst) begin
       stall_q   <= TS_ZERO;
       stalled_q <= 1'b0;
-    end else if (step_q | (stall_timeout == TS_ZERO)) begin
-      stall_q   <= TS_ZERO;
+    end else if (step_q | stall_off | stall_new) begin
+      stall_q   <= stall_timeout - TS_ONE;
       stalled_q <= 1'b0;
     end else if (tick & ~stalled_q) begin
-      stall_q   <= stall_q + TS_ONE;
+      stall_q   <= stall_q - TS_ONE;
       stalled_q <= stall_hit;
     end
   end
