@@ -564,7 +564,7 @@ def run_sim(args, units, rpms) -> dict:
         plans.append((gi, path, tmp / f"out_{gi}.json", tmp / f"progress_{gi}.txt"))
     total = len(cases)
     print(f"sim layer: {total} cases (units {', '.join(n for n, _ in units[:SIM_UNITS])}; "
-          f"{len({c['rpm'] for c in cases if c['kind'] == 'constant'})} speeds x any/A-rising, and a stop) on {sim}, "
+          f"{len({c['rpm'] for c in cases if c['kind'] == 'constant'})} speeds x any/A-rising; a stop, a ramp, a reversal) on {sim}, "
           f"{len(groups)} process(es)", flush=True)
     t0 = time.perf_counter()
     errors = {}
@@ -941,8 +941,9 @@ def write_table(args, units, usum, model, sim, path: Path, wall_s: float) -> lis
           f"Modelled HEDS-5000 units (hedsmodel; 500 cycles/rev, x4 = 2,000 counts/rev) read at "
           f"1 kHz by the estimators of `hedsmodel.velocity` / `sw/enc_qei_velocity.c`. Timebase "
           f"{args.clk_mhz:g} MHz / (PRESCALE {args.prescale} + 1) = {tb.tick_s * 1e9:g} ns tick, "
-          f"TS_W 32; edges timestamped {LATENCY_CLOCKS} clocks after the pins (FILTER_LEN "
-          f"{FILTER_LEN}; a constant, so it cancels); "
+          f"TS_W 32; the model timestamps edges {LATENCY_CLOCKS} clocks after the pins (FILTER_LEN "
+          f"{FILTER_LEN}; the RTL's own offset is measured in the simulated layer; a constant, "
+          "so it cancels); "
           f"estimator stall timeout {args.stall_ms:g} ms. Seed {args.seed}"
           f"{', --quick' if args.quick else ''}; {wall_s / 60:.1f} min on {args.jobs} "
           f"job(s). Relative errors in % of the true shaft speed: *rms* and *max* over the "
