@@ -1217,7 +1217,7 @@ def write_figure(args, units, model, sim, path: Path) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.set_title("M/T A↑: max error added by the timebase", fontsize=11)
     ax.legend(fontsize=7, loc="upper right")
-    axes[0].legend(fontsize=7, loc="lower left", title="solid: latched, dashed: floor",
+    axes[0].legend(fontsize=7, loc="lower left", title="solid: latched, dashed: floor (they overlap)",
                    title_fontsize=7)
     for ax in axes[3:]:
         ax.set_xlabel("shaft speed (rpm)")
