@@ -65,6 +65,7 @@ RESULTS_MD = TOP / "doc" / "results" / "mutation.md"
 DEFAULT_SEED = 1
 DEFAULT_N = 25
 MITER_STEPS = 24  # clocks of the bounded output check of a survivor (equivalence(), stage 2)
+MITER_TIMEOUT = 45  # seconds for it (the characterizer needs ~100 s for 24 steps: it stops early)
 
 T_LS168 = "tb/ls168/test_ls168.py"
 T_COND = "tb/enc_conditioner/test_enc_conditioner.py"
@@ -452,12 +453,18 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
               + "miter -equiv -flatten -make_outputs gold gate miter\n"
               + "hierarchy -top miter\n"
               + f"sat -tempinduct -prove trigger 0 -set-init-zero -seq 1 -maxsteps {MITER_STEPS} "
-              + f"-timeout 120 -show-ports miter\n")
+              + "miter\n")
     log = d / f"m{m.number:02d}_miter.log"
     try:
-        proc = run_yosys(script, log, timeout=300)
-    except subprocess.TimeoutExpired:
-        return False, f"{first}; miter timed out"
+        proc = run_yosys(script, log, timeout=MITER_TIMEOUT)
+    except subprocess.TimeoutExpired:  # the log tells how far the base case got
+        text = log.read_text() if log.exists() else ""
+        if re.search(r"model found for base case", text):
+            return False, f"{first}; outputs differ on a trace from the zero state"
+        steps = re.findall(r"Base case for induction length (\d+) proven", text)
+        return False, (f"{first}; no output difference within {steps[-1]} clocks of the zero state "
+                       f"(miter stopped after {MITER_TIMEOUT} s)" if steps else
+                       f"{first}; miter: no result in {MITER_TIMEOUT} s")
     text = log.read_text() if log.exists() else proc.stdout + proc.stderr
     if proc.returncode == 0 and re.search(r"Induction step proven: SUCCESS", text):
         return True, f"proven equivalent (miter, temporal induction)"
@@ -465,8 +472,10 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
         return False, f"{first}; outputs differ on a trace from the zero state"
     if re.search(r"Reached maximum number of time steps", text):
         return False, f"{first}; no output difference within {MITER_STEPS} clocks of the zero state"
-    if "timeout" in text.lower():
-        return False, f"{first}; miter: solver timeout"
+    if "timeout" in text.lower() or "interrupted" in text.lower():
+        steps = re.findall(r"\[base case (\d+)\]", text)
+        done = f", no output difference within {int(steps[-1]) - 1} clocks" if len(steps) > 1 else ""
+        return False, f"{first}; miter: solver timeout{done}"
     err = re.search(r"ERROR: (.*)", text)
     return False, f"{first}; miter: {err.group(1) if err else 'see ' + str(log.relative_to(TOP))}"
 
@@ -585,15 +594,16 @@ def main() -> int:
             m.result = "killed"
             m.failed_test = failed
         else:
+            t_eq = time.monotonic()
             eq, note = equivalence(root, m)
             m.result = "equivalent" if eq else "survived"
-            m.eq_note = note
+            m.eq_note = note + f" ({time.monotonic() - t_eq:.0f} s)"
         if m.result in ("killed", "timeout") and not args.keep:
             shutil.rmtree(build, ignore_errors=True)
         with lock:
             done[0] += 1
             extra = {"killed": f"by {m.failed_test}", "timeout": f"(> {timeout:.0f} s, counted as killed)",
-                     "equivalent": "(proven)", "survived": f"id {m.mutant_id()} "
+                     "equivalent": f"{m.eq_note}", "survived": f"id {m.mutant_id()} "
                      + ("reviewed" if m.mutant_id() in reviewed else "NOT REVIEWED")
                      + f"; {m.eq_note}"}[m.result]
             print(f"[{done[0]:3d}/{len(todo)}] {c.module:17s} {c.label:28s} m{m.number:02d} "
@@ -664,13 +674,14 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
         md += ["", "## Survivors and equivalent mutants", ""]
         listed = [m for m in mutants if m.result in ("survived", "equivalent")]
         if listed:
-            md += ["| module | corner | id | mutation | result | reason |", "|---|---|---|---|---|---|"]
+            md += ["| module | corner | id | mutation | result | equivalence check | reason |",
+                   "|---|---|---|---|---|---|---|"]
             for m in listed:
                 reason = (reviewed.get(m.mutant_id(), "**not reviewed**") if m.result == "survived"
-                          else m.eq_note)
+                          else "")
                 desc = m.describe().replace("|", "\\|")
                 md.append(f"| {m.corner.module} | {m.corner.label} | {m.mutant_id()} | "
-                          f"`{desc}` | {m.result} | {reason.replace('|', chr(92) + '|')} |")
+                          f"{desc} | {m.result} | {m.eq_note} | {reason.replace('|', chr(92) + '|')} |")
         else:
             md.append("None.")
         RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
