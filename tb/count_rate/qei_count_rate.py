@@ -22,7 +22,7 @@ from cocotb.triggers import ClockCycles
 from cocotbext.quadrature import QuadratureDriver
 from hedsmodel.waveform import random_walk
 from qei_tb import PERIOD_PS, T_NS, QeiBus, pack
-from tbutil import start
+from tbutil import reset_dut, start
 
 
 class Qei:
@@ -58,10 +58,15 @@ class Qei:
 
 
 async def begin(dut) -> tuple[Qei, random.Random]:
+    """Clock, seed, inputs; the bus master is created (driving the bus idle) while rst is held,
+    so no undriven bus input is sampled after reset; then reset and settle."""
     rng = await start(dut, PERIOD_PS, inputs={"a_in": 0, "b_in": 0, "z_in": 0, "probe_in": 0,
-                                               "snap_in": 0})
+                                               "snap_in": 0}, do_reset=False)
+    qei = Qei(dut, rng)
+    await reset_dut(dut)
     await ClockCycles(dut.clk, 30)
-    return Qei(dut, rng), rng
+    await qei.bus.events()  # nothing may be pending after reset but the bus must answer
+    return qei, rng
 
 
 def bound_clocks(f: int) -> float:
