@@ -889,8 +889,8 @@ def sim_report(args, units, results, wall, sim, errors) -> dict:
                           f"{'A↑' if r['edge'] == 'a_rising' else 'any edge'}: the registers add "
                           f"at most {fmt_pct(mt['added_max'], 4)} % "
                           f"{'of the top speed' if r['kind'] == 'reversal' else 'of the reading'}; "
-                          f"{mt['wrong_sign']} readings of the wrong sign, {mt['zeros']} of 0 "
-                          f"(of {mt['n']}).")
+                          f"of {mt['n']} readings, {mt['wrong_sign']} of the wrong sign and "
+                          f"{mt['zeros']} of 0.")
     goals_.append(f"{'MET' if nbad == 0 else 'MISSED'} (through the RTL): {nbad} inconsistencies "
                   f"between the latched registers and the model in {nchk} checks.")
     for r in stops:
