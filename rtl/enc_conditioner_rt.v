@@ -8,7 +8,9 @@
 // for one clock (never with filter_len = 1). An output changes filter_len + 1 clocks after the
 // rising edge that first samples the new level. `valid` rises filter_len + 2 clocks after rst
 // falls (hold a decoder behind this block in reset while it is low).
-// filter_len is clamped to 1 .. MAX_FILTER_LEN (0 acts as 1). It may change at any time: a
+// filter_len is clamped to 1 .. MAX_FILTER_LEN (0 acts as 1) through a register, so a new value
+// acts from the clock after it appears (the reset value is in place when rst falls, so the
+// timings above hold from reset). It may change at any time: a
 // candidate level already seen on at least the new length of samples is accepted at the next
 // differing sample, so a change never loses or invents a level. enc_conditioner is this module
 // with filter_len tied to FILTER_LEN and MAX_FILTER_LEN = FILTER_LEN (then the run counter and
@@ -46,10 +48,16 @@ module enc_conditioner_rt #(
   localparam [4:0] MAX_LAST5 = MAX_LAST_INT[4:0];
 
   // last = clamp(filter_len, 1, MAX_FILTER_LEN) - 1: a differing sample seen with run >= last
-  // accepts.
-  wire [4:0] len_m1 = (filter_len == 5'd0) ? 5'd0 : filter_len - 5'd1;
-  wire [4:0] last5  = (len_m1 > MAX_LAST5) ? MAX_LAST5 : len_m1;
+  // accepts. The clamp is registered (Fmax; updated in every clock, reset or not), so a new
+  // filter_len acts from the clock after it appears.
+  wire [4:0] len_m1  = (filter_len == 5'd0) ? 5'd0 : filter_len - 5'd1;
+  reg  [4:0] last5_q;
+  wire [4:0] last5   = last5_q;
   wire [CW-1:0] last = last5[CW-1:0];
+
+  always @(posedge clk) begin
+    last5_q <= (len_m1 > MAX_LAST5) ? MAX_LAST5 : len_m1;
+  end
 
   // ---- synchronizer: two flip-flops per channel -----------------------------------------------
   reg [1:0] meta_q;  // {b, a} first stage

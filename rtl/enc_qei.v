@@ -13,11 +13,23 @@
 // the index lines up with the channels clock for clock. irq is registered: high from the clock
 // after an enabled event is pending until the clock after it is cleared or disabled.
 // Request/response port: see enc_qei_regs (response in the clock after the request).
+//
+// Build options (defaults: the contract's full peripheral):
+//   PROFILE = 1     issue 12's peripheral: the timing unit (enc_qei_timing) is left out:
+//                   TIMEBASE .. STALL_TIMEOUT read 0 and ignore writes (no bus error), PROBE_TIME
+//                   reads 0, STATUS.STALLED and the STALL, SNAP_READY, PERIOD_READY and PERIOD_OVF
+//                   events stay 0; CAPS.TIMING reads 0. PROFILE = 2 (default): everything.
+//   FUNC_MASK       the count functions built, bit F for CTRL.FUNC value F (x4 = bit 0 .. x1_hyst
+//                   = bit 8; default 511: all). With one bit set the function is fixed: CTRL.FUNC
+//                   reads it and ignores writes, and the decode logic of the others is left out.
+//                   With several, a CTRL.FUNC value outside the mask counts nothing.
 `default_nettype none
 
 module enc_qei #(
-    parameter integer COUNT_W = 32,  // counter width: 8 .. 64
-    parameter integer TS_W    = 32   // timebase / timestamp width: 16 .. 32
+    parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
+    parameter integer TS_W       = 32,  // timebase / timestamp width: 16 .. 32
+    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only
+    parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F: 1 .. 511
 ) (
     input  wire        clk,
     input  wire        rst,         // synchronous, active high
@@ -53,7 +65,30 @@ module enc_qei #(
       $error("enc_qei: parameter TS_W must be in 16 .. 32");
 `endif
     end
+    if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile
+`ifdef __ICARUS__
+      enc_qei__parameter_PROFILE_must_be_1_to_2 u_stop ();
+`else
+      $error("enc_qei: parameter PROFILE must be in 1 .. 2");
+`endif
+    end
+    if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask
+`ifdef __ICARUS__
+      enc_qei__parameter_FUNC_MASK_must_be_1_to_511 u_stop ();
+`else
+      $error("enc_qei: parameter FUNC_MASK must be in 1 .. 511");
+`endif
+    end
   endgenerate
+
+  // PROFILE and FUNC_MASK as the register block's options
+  localparam integer TIMING     = (PROFILE >= 2) ? 1 : 0;
+  localparam integer FIXED_FUNC = (FUNC_MASK == 1)   ? 0 : (FUNC_MASK == 2)   ? 1 :
+                                  (FUNC_MASK == 4)   ? 2 : (FUNC_MASK == 8)   ? 3 :
+                                  (FUNC_MASK == 16)  ? 4 : (FUNC_MASK == 32)  ? 5 :
+                                  (FUNC_MASK == 64)  ? 6 : (FUNC_MASK == 128) ? 7 :
+                                  (FUNC_MASK == 256) ? 8 : -1;
+  localparam [15:0] FUNC_MASK16 = FUNC_MASK[15:0];
 
   function [63:0] zext_count;
     input [COUNT_W-1:0] v;
@@ -127,6 +162,11 @@ module enc_qei #(
       .valid     (valid_zp_unused)
   );
 
+  // CTRL.FUNC as the core sees it: with several functions left out, the others count nothing
+  // (15); with one (FIXED_FUNC) or all, the register block's CTRL.FUNC as it is.
+  wire [3:0] func_eff = (FIXED_FUNC >= 0 || FUNC_MASK == 511 || FUNC_MASK16[ctrl_func]) ?
+                        ctrl_func : 4'd15;
+
   // ---- core ---------------------------------------------------------------------------------------------
   wire [COUNT_W-1:0] count_q, idx_latch, probe_latch;
   wire [TS_W-1:0]    probe_time;
@@ -151,7 +191,7 @@ module enc_qei #(
       .inv_a         (ctrl_inv_a),
       .inv_b         (ctrl_inv_b),
       .inv_z         (ctrl_inv_z),
-      .func          (ctrl_func),
+      .func          (func_eff),
       .range         (ctrl_range),
       .preset        (zext_count_hi_lo(preset_hi, preset_lo)),
       .ceiling       (zext_count_hi_lo(ceiling_hi, ceiling_lo)),
@@ -209,45 +249,67 @@ module enc_qei #(
   wire               period_ovf_flag, period_dir_flag, stalled;
   wire               ev_snap, ev_period, ev_period_ovf, ev_stall;
 
-  enc_qei_timing #(
-      .COUNT_W(COUNT_W),
-      .TS_W   (TS_W)
-  ) u_timing (
-      .clk            (clk),
-      .rst            (rst),
-      .prescale       (tb_prescale),
-      .edge_any       (edge_any),
-      .edge_a_rise    (edge_a_rise),
-      .step           (step_up | step_dn),
-      .applied_up     (applied_up),
-      .applied_dn     (applied_dn),
-      .dir_change     (ev_dir_change),
-      .count          (count_q),
-      .snap_cmd       (snap_cmd),
-      .snap_in        (snap_in),
-      .snap_in_en     (snap_in_en),
-      .snap_period_en (snap_period_en),
-      .snap_edge      (snap_edge),
-      .snap_period    (snap_period[TS_W-1:0]),
-      .period_en      (period_en),
-      .period_edge    (period_edge),
-      .period_n       (period_n),
-      .stall_timeout  (stall_timeout[TS_W-1:0]),
-      .timebase       (timebase),
-      .snap_count     (snap_count),
-      .snap_time      (snap_time),
-      .snap_edge_time (snap_edge_time),
-      .snap_delta     (snap_delta),
-      .snap_edge_delta(snap_edge_delta),
-      .period         (period),
-      .period_ovf_flag(period_ovf_flag),
-      .period_dir_flag(period_dir_flag),
-      .stalled        (stalled),
-      .ev_snap        (ev_snap),
-      .ev_period      (ev_period),
-      .ev_period_ovf  (ev_period_ovf),
-      .ev_stall       (ev_stall)
-  );
+  generate
+    if (TIMING != 0) begin : g_timing
+    enc_qei_timing #(
+        .COUNT_W(COUNT_W),
+        .TS_W   (TS_W)
+    ) u_timing (
+        .clk            (clk),
+        .rst            (rst),
+        .prescale       (tb_prescale),
+        .edge_any       (edge_any),
+        .edge_a_rise    (edge_a_rise),
+        .step           (step_up | step_dn),
+        .applied_up     (applied_up),
+        .applied_dn     (applied_dn),
+        .dir_change     (ev_dir_change),
+        .count          (count_q),
+        .snap_cmd       (snap_cmd),
+        .snap_in        (snap_in),
+        .snap_in_en     (snap_in_en),
+        .snap_period_en (snap_period_en),
+        .snap_edge      (snap_edge),
+        .snap_period    (snap_period[TS_W-1:0]),
+        .period_en      (period_en),
+        .period_edge    (period_edge),
+        .period_n       (period_n),
+        .stall_timeout  (stall_timeout[TS_W-1:0]),
+        .timebase       (timebase),
+        .snap_count     (snap_count),
+        .snap_time      (snap_time),
+        .snap_edge_time (snap_edge_time),
+        .snap_delta     (snap_delta),
+        .snap_edge_delta(snap_edge_delta),
+        .period         (period),
+        .period_ovf_flag(period_ovf_flag),
+        .period_dir_flag(period_dir_flag),
+        .stalled        (stalled),
+        .ev_snap        (ev_snap),
+        .ev_period      (ev_period),
+        .ev_period_ovf  (ev_period_ovf),
+        .ev_stall       (ev_stall)
+    );
+    end else begin : g_no_timing
+      wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn, applied_up, applied_dn,
+                             count_q, snap_cmd, snap_in, snap_in_en, snap_period_en, snap_edge, snap_period,
+                             period_en, period_edge, period_n, stall_timeout, tb_prescale};
+      assign timebase        = {TS_W{1'b0}};
+      assign snap_count      = {COUNT_W{1'b0}};
+      assign snap_time       = {TS_W{1'b0}};
+      assign snap_edge_time  = {TS_W{1'b0}};
+      assign snap_delta      = 32'd0;
+      assign snap_edge_delta = 32'd0;
+      assign period          = {TS_W{1'b0}};
+      assign period_ovf_flag = 1'b0;
+      assign period_dir_flag = 1'b0;
+      assign stalled         = 1'b0;
+      assign ev_snap         = 1'b0;
+      assign ev_period       = 1'b0;
+      assign ev_period_ovf   = 1'b0;
+      assign ev_stall        = 1'b0;
+    end
+  endgenerate
 
   // verilator lint_off UNUSEDSIGNAL
   function [COUNT_W-1:0] zext_count_hi_lo;
@@ -267,8 +329,10 @@ module enc_qei #(
 
   // ---- register block -------------------------------------------------------------------------------
   enc_qei_regs #(
-      .COUNT_W(COUNT_W),
-      .TS_W   (TS_W)
+      .TIMING    (TIMING),
+      .FIXED_FUNC(FIXED_FUNC),
+      .COUNT_W   (COUNT_W),
+      .TS_W      (TS_W)
   ) u_regs (
       .clk                    (clk),
       .rst                    (rst),
@@ -284,7 +348,7 @@ module enc_qei #(
       .caps_ts_w              (TS_W8),
       .caps_index             (1'b1),
       .caps_probe             (1'b1),
-      .caps_timing            (1'b1),
+      .caps_timing            (TIMING != 0),
       .ctrl_en                (ctrl_en),
       .ctrl_swap_ab           (ctrl_swap_ab),
       .ctrl_inv_a             (ctrl_inv_a),

@@ -2,7 +2,8 @@
 // enc_qei_axil -- enc_qei with an AXI4-Lite slave port (32-bit data, 8-bit byte address).
 //
 // A thin adapter: one skid register per address/data channel (AW, W, AR), one request to
-// enc_qei at a time, and the response held on B or R until the master takes it. A write is
+// enc_qei at a time, issued from a register (the clock after the adapter picks it: Fmax), and
+// the response held on B or R until the master takes it. A write is
 // issued once both its address and data have arrived; reads and writes alternate when both
 // wait. An unmapped offset answers SLVERR (reads 0, writes nothing); every access completes
 // whatever the master's ready/valid timing. awprot/arprot are ignored. All the peripheral's
@@ -10,8 +11,10 @@
 `default_nettype none
 
 module enc_qei_axil #(
-    parameter integer COUNT_W = 32,  // counter width: 8 .. 64
-    parameter integer TS_W    = 32   // timebase / timestamp width: 16 .. 32
+    parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
+    parameter integer TS_W       = 32,  // timebase / timestamp width: 16 .. 32
+    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only (see enc_qei)
+    parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,            // synchronous, active high
@@ -64,6 +67,20 @@ module enc_qei_axil #(
       $error("enc_qei_axil: parameter TS_W must be in 16 .. 32");
 `endif
     end
+    if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile
+`ifdef __ICARUS__
+      enc_qei_axil__parameter_PROFILE_must_be_1_to_2 u_stop ();
+`else
+      $error("enc_qei_axil: parameter PROFILE must be in 1 .. 2");
+`endif
+    end
+    if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask
+`ifdef __ICARUS__
+      enc_qei_axil__parameter_FUNC_MASK_must_be_1_to_511 u_stop ();
+`else
+      $error("enc_qei_axil: parameter FUNC_MASK must be in 1 .. 511");
+`endif
+    end
   endgenerate
 
   // ---- channel registers -------------------------------------------------------------------------
@@ -71,7 +88,10 @@ module enc_qei_axil #(
   reg [7:0]  awaddr_q, araddr_q;
   reg [31:0] wdata_q;
   reg [3:0]  wstrb_q;
-  reg        pend_q;                 // a request is in enc_qei (response next clock)
+  reg        req_q;                  // the request to enc_qei (this clock)
+  reg        req_wr_q;               // ... a write
+  reg [7:0]  req_addr_q;             // ... its address
+  reg        pend_q;                 // a request is issued and its response has not come
   reg        pend_wr_q;              // ... and it is a write
   reg        last_rd_q;              // the last request issued was a read (alternation)
   reg        bvalid_q, rvalid_q;
@@ -95,6 +115,9 @@ module enc_qei_axil #(
       araddr_q  <= 8'd0;
       wdata_q   <= 32'd0;
       wstrb_q   <= 4'd0;
+      req_q     <= 1'b0;
+      req_wr_q  <= 1'b0;
+      req_addr_q <= 8'd0;
       pend_q    <= 1'b0;
       pend_wr_q <= 1'b0;
       last_rd_q <= 1'b0;
@@ -123,10 +146,15 @@ module enc_qei_axil #(
       end else if (issue_rd) begin
         ar_v_q <= 1'b0;
       end
-      pend_q <= issue_rd | issue_wr;
+      req_q <= issue_rd | issue_wr;
       if (issue_rd | issue_wr) begin
-        pend_wr_q <= issue_wr;
-        last_rd_q <= issue_rd;
+        pend_q     <= 1'b1;
+        pend_wr_q  <= issue_wr;
+        last_rd_q  <= issue_rd;
+        req_wr_q   <= issue_wr;
+        req_addr_q <= issue_wr ? awaddr_q : araddr_q;
+      end else if (resp_valid) begin
+        pend_q <= 1'b0;
       end
       if (resp_valid & pend_wr_q) begin
         bvalid_q <= 1'b1;
@@ -145,14 +173,16 @@ module enc_qei_axil #(
   end
 
   enc_qei #(
-      .COUNT_W(COUNT_W),
-      .TS_W   (TS_W)
+      .COUNT_W   (COUNT_W),
+      .TS_W      (TS_W),
+      .PROFILE   (PROFILE),
+      .FUNC_MASK (FUNC_MASK)
   ) u_qei (
       .clk       (clk),
       .rst       (rst),
-      .req_valid (issue_rd | issue_wr),
-      .req_write (issue_wr),
-      .req_addr  (issue_wr ? awaddr_q : araddr_q),
+      .req_valid (req_q),
+      .req_write (req_wr_q),
+      .req_addr  (req_addr_q),
       .req_wdata (wdata_q),
       .req_wstrb (wstrb_q),
       .resp_valid(resp_valid),

@@ -247,17 +247,32 @@ module enc_qei_core #(
   reg  [31:0]        hi_stage_q;
   reg  [31:0]        hi_latch_q;
 
-  wire at_zero = (count_q == {COUNT_W{1'b0}});
+  reg  zero_q;  // count_q == 0: a flag register, set from the next count's candidates (Fmax)
+  wire at_zero = zero_q;
   wire at_max  = (count_q == {COUNT_W{1'b1}});
-  wire at_ceil = (count_q >= ceiling);
+
+  // at_ceil = (count_q >= ceiling) from 16-bit slices compared side by side (short carry chains),
+  // the slowest signal here: the next count below is arranged so that it selects last (Fmax)
+  localparam integer NSL = (COUNT_W + 15) / 16;
+  wire [63:0] cq64 = zext64(count_q);
+  wire [63:0] ce64 = zext64(ceiling);
+  reg         at_ceil;
+  integer     k;
+
+  always @(*) begin
+    at_ceil = 1'b1;
+    for (k = 0; k < NSL; k = k + 1) begin
+      at_ceil = (cq64[16*k +: 16] > ce64[16*k +: 16]) |
+                ((cq64[16*k +: 16] == ce64[16*k +: 16]) & at_ceil);
+    end
+  end
+
   wire [COUNT_W-1:0] count_inc = count_q + {{(COUNT_W-1){1'b0}}, 1'b1};
   wire [COUNT_W-1:0] count_dec = count_q - {{(COUNT_W-1){1'b0}}, 1'b1};
 
-  reg [COUNT_W-1:0] stepped;  // count after this clock's step (before loads)
   reg               ovf, unf, took;
 
   always @(*) begin
-    stepped = count_q;
     ovf     = 1'b0;
     unf     = 1'b0;
     took    = 1'b0;
@@ -265,33 +280,27 @@ module enc_qei_core #(
     case (range)
       R_FREE: begin
         if (step_up) begin
-          stepped = count_inc;
           ovf     = at_max;
           took    = 1'b1;
         end else if (step_dn) begin
-          stepped = count_dec;
           unf     = at_zero;
           took    = 1'b1;
         end
       end
       R_MODULO: begin
         if (step_up) begin
-          stepped = at_ceil ? {COUNT_W{1'b0}} : count_inc;
           ovf     = at_ceil;
           took    = 1'b1;
         end else if (step_dn) begin
-          stepped = at_zero ? ceiling : count_dec;
           unf     = at_zero;
           took    = 1'b1;
         end
       end
       R_LIMIT: begin
         if (step_up) begin
-          stepped = at_ceil ? count_q : count_inc;
           ovf     = at_ceil;
           took    = ~at_ceil;
         end else if (step_dn) begin
-          stepped = at_zero ? count_q : count_dec;
           unf     = at_zero;
           took    = ~at_zero;
         end
@@ -299,12 +308,10 @@ module enc_qei_core #(
       R_NON_RECYCLE: begin
         if (!stopped_q) begin
           if (step_up) begin
-            stepped   = at_ceil ? count_q : count_inc;
             ovf       = at_ceil;
             took      = ~at_ceil;
             stopped_d = at_ceil;
           end else if (step_dn) begin
-            stepped   = at_zero ? count_q : count_dec;
             unf       = at_zero;
             took      = ~at_zero;
             stopped_d = at_zero;
@@ -347,14 +354,64 @@ module enc_qei_core #(
   // verilator lint_on UNUSEDSIGNAL
   wire        load     = count_lo_wr | idx_preset;
 
+  // The same next count as "load value, else stepped", arranged as
+  //   count_d = (up_ceil & at_ceil) ? (modulo ? 0 : count_q) : count_other
+  // where count_other is the next count when the count is below CEILING (all early signals).
+  wire        bounded = (range != R_FREE) & ~((range == R_NON_RECYCLE) & stopped_q);
+  wire        up_ceil = ~load & step_up & bounded;  // an up step that CEILING may stop or wrap
+  wire [COUNT_W-1:0] ceil_val = (range == R_MODULO) ? {COUNT_W{1'b0}} : count_q;  // up at CEILING
+  reg  [COUNT_W-1:0] step_other;   // the count after this clock's step when below CEILING
+  reg  [COUNT_W-1:0] count_other;  // ... and after the loads
+  reg  [COUNT_W-1:0] stepped;      // the count after this clock's step (before loads)
+
   always @(*) begin
-    if (count_lo_wr) begin
-      count_d = wr_value[COUNT_W-1:0];
-    end else if (idx_preset) begin
-      count_d = preset;
+    if ((range == R_NON_RECYCLE) & stopped_q) begin
+      step_other = count_q;
+    end else if (step_up) begin
+      step_other = count_inc;
+    end else if (step_dn) begin
+      if (at_zero & (range != R_FREE)) begin
+        step_other = (range == R_MODULO) ? ceiling : count_q;
+      end else begin
+        step_other = count_dec;
+      end
     end else begin
-      count_d = stepped;
+      step_other = count_q;
     end
+    if (count_lo_wr) begin
+      count_other = wr_value[COUNT_W-1:0];
+    end else if (idx_preset) begin
+      count_other = preset;
+    end else begin
+      count_other = step_other;
+    end
+    count_d = (up_ceil & at_ceil) ? ceil_val : count_other;
+    stepped = (step_up & bounded & at_ceil) ? ceil_val : step_other;
+  end
+
+  // zero_d = (count_d == 0), from the same choice over the candidates' zero tests
+  reg zero_other, zero_d;
+
+  always @(*) begin
+    if ((range == R_NON_RECYCLE) & stopped_q) begin
+      zero_other = zero_q;
+    end else if (step_up) begin
+      zero_other = at_max;
+    end else if (step_dn) begin
+      if (at_zero & (range != R_FREE)) begin
+        zero_other = (range == R_MODULO) ? (ceiling == {COUNT_W{1'b0}}) : zero_q;
+      end else begin
+        zero_other = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
+      end
+    end else begin
+      zero_other = zero_q;
+    end
+    if (count_lo_wr) begin
+      zero_other = (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}});
+    end else if (idx_preset) begin
+      zero_other = (preset == {COUNT_W{1'b0}});
+    end
+    zero_d = (up_ceil & at_ceil) ? ((range == R_MODULO) | zero_q) : zero_other;
   end
 
   reg upd_q;  // the count changed (step or load) at the last clock edge
@@ -362,10 +419,12 @@ module enc_qei_core #(
   always @(posedge clk) begin
     if (rst) begin
       count_q   <= {COUNT_W{1'b0}};
+      zero_q    <= 1'b1;
       stopped_q <= 1'b0;
       upd_q     <= 1'b0;
     end else begin
       count_q   <= count_d;
+      zero_q    <= zero_d;
       stopped_q <= stopped_d;
       upd_q     <= load | took;
     end

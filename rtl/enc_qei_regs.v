@@ -12,6 +12,8 @@
 `default_nettype none
 
 module enc_qei_regs #(
+    parameter integer TIMING = 1,  // 1: timing registers present, 0: read 0 (checked by enc_qei)
+    parameter integer FIXED_FUNC = -1,  // -1: the field is storage, >= 0: fixed to it (checked by enc_qei)
     parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)
     parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)
 ) (
@@ -229,7 +231,7 @@ module enc_qei_regs #(
   end
 
   reg [3:0] ctrl_func_q;  // CTRL.FUNC
-  assign ctrl_func = ctrl_func_q;
+  assign ctrl_func = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
   always @(posedge clk) begin
     if (rst) begin
       ctrl_func_q <= 4'h0;
@@ -585,7 +587,7 @@ module enc_qei_regs #(
   end
 
   reg [15:0] tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
-  assign tb_prescale_prescale = tb_prescale_prescale_q;
+  assign tb_prescale_prescale = ((TIMING != 0) ? tb_prescale_prescale_q : 16'd0);
   always @(posedge clk) begin
     if (rst) begin
       tb_prescale_prescale_q <= 16'h0;
@@ -595,14 +597,15 @@ module enc_qei_regs #(
   end
 
   reg snap_ctrl_cmd_q;  // SNAP_CTRL.CMD: one-clock pulse
-  assign snap_ctrl_cmd = snap_ctrl_cmd_q;
+  assign snap_ctrl_cmd = ((TIMING != 0) ? snap_ctrl_cmd_q : 1'd0);
   always @(posedge clk) begin
     if (rst) snap_ctrl_cmd_q <= 1'd0;
-    else snap_ctrl_cmd_q <= {1{wr_req & (req_addr[7:2] == A_SNAP_CTRL)}} & req_wdata[0:0] & bmask[0:0];
+    else if (wr_req & (req_addr[7:2] == A_SNAP_CTRL)) snap_ctrl_cmd_q <= req_wdata[0:0] & bmask[0:0];
+    else snap_ctrl_cmd_q <= 1'd0;
   end
 
   reg snap_ctrl_in_en_q;  // SNAP_CTRL.IN_EN
-  assign snap_ctrl_in_en = snap_ctrl_in_en_q;
+  assign snap_ctrl_in_en = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
   always @(posedge clk) begin
     if (rst) begin
       snap_ctrl_in_en_q <= 1'h0;
@@ -612,7 +615,7 @@ module enc_qei_regs #(
   end
 
   reg snap_ctrl_period_en_q;  // SNAP_CTRL.PERIOD_EN
-  assign snap_ctrl_period_en = snap_ctrl_period_en_q;
+  assign snap_ctrl_period_en = ((TIMING != 0) ? snap_ctrl_period_en_q : 1'd0);
   always @(posedge clk) begin
     if (rst) begin
       snap_ctrl_period_en_q <= 1'h0;
@@ -622,7 +625,7 @@ module enc_qei_regs #(
   end
 
   reg snap_ctrl_edge_q;  // SNAP_CTRL.EDGE
-  assign snap_ctrl_edge = snap_ctrl_edge_q;
+  assign snap_ctrl_edge = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
   always @(posedge clk) begin
     if (rst) begin
       snap_ctrl_edge_q <= 1'h0;
@@ -632,7 +635,7 @@ module enc_qei_regs #(
   end
 
   reg [31:0] snap_period_value_q;  // SNAP_PERIOD.VALUE
-  assign snap_period_value = snap_period_value_q;
+  assign snap_period_value = ((TIMING != 0) ? snap_period_value_q : 32'd0);
   always @(posedge clk) begin
     if (rst) begin
       snap_period_value_q <= 32'h0 & SZ_TS[31:0];
@@ -642,7 +645,7 @@ module enc_qei_regs #(
   end
 
   reg period_ctrl_en_q;  // PERIOD_CTRL.EN
-  assign period_ctrl_en = period_ctrl_en_q;
+  assign period_ctrl_en = ((TIMING != 0) ? period_ctrl_en_q : 1'd0);
   always @(posedge clk) begin
     if (rst) begin
       period_ctrl_en_q <= 1'h0;
@@ -652,7 +655,7 @@ module enc_qei_regs #(
   end
 
   reg period_ctrl_edge_q;  // PERIOD_CTRL.EDGE
-  assign period_ctrl_edge = period_ctrl_edge_q;
+  assign period_ctrl_edge = ((TIMING != 0) ? period_ctrl_edge_q : 1'd0);
   always @(posedge clk) begin
     if (rst) begin
       period_ctrl_edge_q <= 1'h0;
@@ -662,7 +665,7 @@ module enc_qei_regs #(
   end
 
   reg [7:0] period_ctrl_n_q;  // PERIOD_CTRL.N
-  assign period_ctrl_n = period_ctrl_n_q;
+  assign period_ctrl_n = ((TIMING != 0) ? period_ctrl_n_q : 8'd0);
   always @(posedge clk) begin
     if (rst) begin
       period_ctrl_n_q <= 8'h1;
@@ -672,7 +675,7 @@ module enc_qei_regs #(
   end
 
   reg [31:0] stall_timeout_value_q;  // STALL_TIMEOUT.VALUE
-  assign stall_timeout_value = stall_timeout_value_q;
+  assign stall_timeout_value = ((TIMING != 0) ? stall_timeout_value_q : 32'd0);
   always @(posedge clk) begin
     if (rst) begin
       stall_timeout_value_q <= 32'h0 & SZ_TS[31:0];
@@ -706,7 +709,7 @@ module enc_qei_regs #(
         rd_d[2:2] = ctrl_inv_a_q;
         rd_d[3:3] = ctrl_inv_b_q;
         rd_d[4:4] = ctrl_inv_z_q;
-        rd_d[11:8] = ctrl_func_q;
+        rd_d[11:8] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
         rd_d[13:12] = ctrl_range_q;
         rd_d[20:16] = ctrl_filter_len_q;
       end
@@ -797,49 +800,75 @@ module enc_qei_regs #(
         rd_d[15:0] = glitch_count_value_q;
       end
       A_TIMEBASE: begin
-        rd_d[31:0] = timebase_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = timebase_value;
+        end
       end
       A_TB_PRESCALE: begin
-        rd_d[15:0] = tb_prescale_prescale_q;
+        if (TIMING != 0) begin
+          rd_d[15:0] = tb_prescale_prescale_q;
+        end
       end
       A_SNAP_CTRL: begin
-        rd_d[1:1] = snap_ctrl_in_en_q;
-        rd_d[2:2] = snap_ctrl_period_en_q;
-        rd_d[3:3] = snap_ctrl_edge_q;
+        if (TIMING != 0) begin
+          rd_d[1:1] = snap_ctrl_in_en_q;
+          rd_d[2:2] = snap_ctrl_period_en_q;
+          rd_d[3:3] = snap_ctrl_edge_q;
+        end
       end
       A_SNAP_PERIOD: begin
-        rd_d[31:0] = snap_period_value_q;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_period_value_q;
+        end
       end
       A_SNAP_COUNT_LO: begin
-        rd_d[31:0] = snap_count_lo_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_count_lo_value;
+        end
       end
       A_SNAP_COUNT_HI: begin
-        rd_d[31:0] = snap_count_hi_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_count_hi_value;
+        end
       end
       A_SNAP_TIME: begin
-        rd_d[31:0] = snap_time_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_time_value;
+        end
       end
       A_SNAP_EDGE_TIME: begin
-        rd_d[31:0] = snap_edge_time_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_edge_time_value;
+        end
       end
       A_SNAP_DELTA: begin
-        rd_d[31:0] = snap_delta_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_delta_value;
+        end
       end
       A_SNAP_EDGE_DELTA: begin
-        rd_d[31:0] = snap_edge_delta_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = snap_edge_delta_value;
+        end
       end
       A_PERIOD_CTRL: begin
-        rd_d[0:0] = period_ctrl_en_q;
-        rd_d[1:1] = period_ctrl_edge_q;
-        rd_d[15:8] = period_ctrl_n_q;
-        rd_d[16:16] = period_ctrl_overflow;
-        rd_d[17:17] = period_ctrl_dir_change;
+        if (TIMING != 0) begin
+          rd_d[0:0] = period_ctrl_en_q;
+          rd_d[1:1] = period_ctrl_edge_q;
+          rd_d[15:8] = period_ctrl_n_q;
+          rd_d[16:16] = period_ctrl_overflow;
+          rd_d[17:17] = period_ctrl_dir_change;
+        end
       end
       A_PERIOD: begin
-        rd_d[31:0] = period_value;
+        if (TIMING != 0) begin
+          rd_d[31:0] = period_value;
+        end
       end
       A_STALL_TIMEOUT: begin
-        rd_d[31:0] = stall_timeout_value_q;
+        if (TIMING != 0) begin
+          rd_d[31:0] = stall_timeout_value_q;
+        end
       end
       default: hit_d = 1'b0;
     endcase

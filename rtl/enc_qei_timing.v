@@ -97,21 +97,34 @@ module enc_qei_timing #(
   end
 
   // ---- timebase ----------------------------------------------------------------------------------
+  // The prescaler counts down from PRESCALE to 0 (a tick at 0), with a registered zero flag. A
+  // change of PRESCALE is seen one clock after the new value (restart, a register: Fmax) and
+  // restarts it then.
   reg [15:0]     pre_q;
-  reg [15:0]     prescale_q;  // last clock's PRESCALE: a change restarts the prescaler
+  reg            pre_zero_q;  // pre_q == 0
+  reg [15:0]     prescale_q;  // last clock's PRESCALE
+  reg            restart;     // PRESCALE changed at the last clock edge
   reg [TS_W-1:0] tb_q;
 
-  wire restart = (prescale != prescale_q);
-  wire tick    = ~restart & (pre_q >= prescale);
+  wire tick = ~restart & pre_zero_q;
 
   always @(posedge clk) begin
     if (rst) begin
       pre_q      <= 16'd0;
+      pre_zero_q <= 1'b1;
       prescale_q <= 16'd0;
+      restart    <= 1'b0;
       tb_q       <= TS_ZERO;
     end else begin
       prescale_q <= prescale;
-      pre_q      <= (restart | tick) ? 16'd0 : pre_q + 16'd1;
+      restart    <= (prescale != prescale_q);
+      if (restart | tick) begin
+        pre_q      <= prescale;
+        pre_zero_q <= (prescale == 16'd0);
+      end else begin
+        pre_q      <= pre_q - 16'd1;
+        pre_zero_q <= (pre_q == 16'd1);
+      end
       if (tick) begin
         tb_q <= tb_q + TS_ONE;
       end
@@ -120,26 +133,31 @@ module enc_qei_timing #(
 
   // ---- snapshot ------------------------------------------------------------------------------------
   // unit timer: counts down from SNAP_PERIOD - 1 once per tick, snaps on the tick at 0
+  // (unit_zero_q: unit_q == 0, a registered flag)
   reg  [TS_W-1:0] unit_q;
+  reg             unit_zero_q;
   reg             snap_in_q;
   wire [TS_W-1:0] unit_load = (snap_period == TS_ZERO) ? TS_ZERO : snap_period - TS_ONE;
-  wire            unit_hit  = snap_period_en & tick & (unit_q == TS_ZERO);
+  wire            unit_hit  = snap_period_en & tick & unit_zero_q;
   // the request is registered (Fmax): the snapshot is taken in the clock after it, all values
   // of that one clock
   reg             snap_req;
 
   always @(posedge clk) begin
     if (rst) begin
-      unit_q    <= TS_ZERO;
-      snap_in_q <= 1'b0;
-      snap_req  <= 1'b0;
+      unit_q      <= TS_ZERO;
+      unit_zero_q <= 1'b1;
+      snap_in_q   <= 1'b0;
+      snap_req    <= 1'b0;
     end else begin
       snap_in_q <= snap_in;
       snap_req  <= snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
       if (~snap_period_en | unit_hit) begin
-        unit_q <= unit_load;
+        unit_q      <= unit_load;
+        unit_zero_q <= (snap_period[TS_W-1:1] == {(TS_W-1){1'b0}});  // SNAP_PERIOD 0 or 1
       end else if (tick) begin
-        unit_q <= unit_q - TS_ONE;
+        unit_q      <= unit_q - TS_ONE;
+        unit_zero_q <= (unit_q == TS_ONE);
       end
     end
   end
@@ -149,11 +167,12 @@ module enc_qei_timing #(
   reg  [31:0] delta_q;      // applied steps since the previous snapshot
   reg  [31:0] tail_q;       // applied steps since the last selected edge
   reg  [31:0] head_q;       // steps from the previous snapshot's last selected edge to the last one
+  reg  [31:0] acc_q;        // head_q + tail_q, kept by its own adder (no adder chain for Fmax)
   reg  [TS_W-1:0] last_edge_q;  // timestamp of the last selected edge
   wire [31:0] delta_now = delta_q + s_now;
-  wire [31:0] tail_s    = tail_q + s_now;
-  wire [31:0] tail_now  = sel_snap ? 32'd0 : tail_s;
-  wire [31:0] head_now  = sel_snap ? head_q + tail_s : head_q;
+  wire [31:0] tail_now  = sel_snap ? 32'd0 : tail_q + s_now;
+  wire [31:0] acc_now   = acc_q + s_now;  // = head_q + tail_q + s_now
+  wire [31:0] head_now  = sel_snap ? acc_now : head_q;
   wire [TS_W-1:0] edge_now = sel_snap ? tb_q : last_edge_q;
 
   reg [COUNT_W-1:0] snap_count_q;
@@ -167,6 +186,7 @@ module enc_qei_timing #(
       delta_q           <= 32'd0;
       tail_q            <= 32'd0;
       head_q            <= 32'd0;
+      acc_q             <= 32'd0;
       last_edge_q       <= TS_ZERO;
       snap_count_q      <= {COUNT_W{1'b0}};
       snap_time_q       <= TS_ZERO;
@@ -179,6 +199,7 @@ module enc_qei_timing #(
       if (snap_req) begin
         delta_q           <= 32'd0;
         head_q            <= 32'd0;
+        acc_q             <= tail_now;
         snap_count_q      <= count;
         snap_time_q       <= tb_q;
         snap_edge_time_q  <= edge_now;
@@ -187,21 +208,33 @@ module enc_qei_timing #(
       end else begin
         delta_q <= delta_now;
         head_q  <= head_now;
+        acc_q   <= acc_now;
       end
     end
   end
 
   // ---- period ---------------------------------------------------------------------------------------
+  // (per_last_q: PERIOD_CTRL.N - 1, registered, so a new N counts from the clock after the write;
+  // ticks_max_q: ticks_q == all ones, a registered flag)
   wire       sel_per  = period_edge ? edge_a_rise_q : edge_any_q;
-  wire [7:0] per_last = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
-  reg        started_q, ovf_q, dir_q;
+  reg  [7:0] per_last_q;
+  reg        started_q, ovf_q, dir_q, ticks_max_q;
   reg [7:0]  n_q;
   reg [TS_W-1:0] ticks_q;
   reg [TS_W-1:0] period_q;
   reg        period_ovf_q, period_dir_q;
 
-  wire capture  = period_en & started_q & sel_per & (n_q == per_last);
-  wire saturate = period_en & started_q & ~(sel_per & (n_q == per_last)) & tick & (ticks_q == TS_MAX);
+  wire n_last   = (n_q == per_last_q);
+  wire capture  = period_en & started_q & sel_per & n_last;
+  wire saturate = period_en & started_q & ~(sel_per & n_last) & tick & ticks_max_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      per_last_q <= 8'd0;
+    end else begin
+      per_last_q <= (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
+    end
+  end
 
   always @(posedge clk) begin
     if (rst) begin
@@ -210,19 +243,21 @@ module enc_qei_timing #(
       dir_q        <= 1'b0;
       n_q          <= 8'd0;
       ticks_q      <= TS_ZERO;
+      ticks_max_q  <= 1'b0;
       period_q     <= TS_ZERO;
       period_ovf_q <= 1'b0;
       period_dir_q <= 1'b0;
     end else if (!period_en) begin
       started_q <= 1'b0;
-    end else if (sel_per & (~started_q | capture)) begin
+    end else if (sel_per & (~started_q | n_last)) begin
       // a start edge (the first, or the end edge of the last measurement)
-      started_q <= 1'b1;
-      ovf_q     <= 1'b0;
-      dir_q     <= 1'b0;
-      n_q       <= 8'd0;
-      ticks_q   <= tick ? TS_ONE : TS_ZERO;
-      if (capture) begin
+      started_q   <= 1'b1;
+      ovf_q       <= 1'b0;
+      dir_q       <= 1'b0;
+      n_q         <= 8'd0;
+      ticks_q     <= tick ? TS_ONE : TS_ZERO;
+      ticks_max_q <= 1'b0;
+      if (started_q) begin  // (capture)
         period_q     <= ovf_q ? TS_MAX : ticks_q;
         period_ovf_q <= ovf_q;
         period_dir_q <= dir_q | dir_change_q;
@@ -233,10 +268,11 @@ module enc_qei_timing #(
       end
       dir_q <= dir_q | dir_change_q;
       if (tick) begin
-        if (ticks_q == TS_MAX) begin
+        if (ticks_max_q) begin
           ovf_q <= 1'b1;
         end else begin
-          ticks_q <= ticks_q + TS_ONE;
+          ticks_q     <= ticks_q + TS_ONE;
+          ticks_max_q <= (ticks_q == (TS_MAX - TS_ONE));
         end
       end
     end
@@ -244,33 +280,40 @@ module enc_qei_timing #(
 
   // ---- stall ----------------------------------------------------------------------------------------
   // counts down from STALL_TIMEOUT - 1 once per tick after each step (or a change of
-  // STALL_TIMEOUT); the tick at 0 stalls
+  // STALL_TIMEOUT); the tick at 0 stalls (stall_zero_q: stall_q == 0, a registered flag). A new
+  // STALL_TIMEOUT (and 0 = off) is seen one clock after it appears (registered compares: Fmax).
   reg  [TS_W-1:0] stall_q;
   reg  [TS_W-1:0] stall_timeout_q;
-  reg             stalled_q;
-  wire            stall_off = (stall_timeout == TS_ZERO);
-  wire            stall_new = (stall_timeout != stall_timeout_q);
-  wire            stall_hit = ~stall_off & ~stall_new & ~stalled_q & ~step_q & tick &
-                              (stall_q == TS_ZERO);
+  reg             stalled_q, stall_zero_q;
+  reg             stall_off;  // STALL_TIMEOUT was 0 in the last clock
+  reg             stall_new;  // STALL_TIMEOUT changed at the last clock edge
+  wire            stall_hit = ~stall_off & ~stall_new & ~stalled_q & ~step_q & tick & stall_zero_q;
 
   always @(posedge clk) begin
     if (rst) begin
       stall_timeout_q <= TS_ZERO;
+      stall_off       <= 1'b1;
+      stall_new       <= 1'b0;
     end else begin
       stall_timeout_q <= stall_timeout;
+      stall_off       <= (stall_timeout == TS_ZERO);
+      stall_new       <= (stall_timeout != stall_timeout_q);
     end
   end
 
   always @(posedge clk) begin
     if (rst) begin
-      stall_q   <= TS_ZERO;
-      stalled_q <= 1'b0;
+      stall_q      <= TS_ZERO;
+      stall_zero_q <= 1'b1;
+      stalled_q    <= 1'b0;
     end else if (step_q | stall_off | stall_new) begin
-      stall_q   <= stall_timeout - TS_ONE;
-      stalled_q <= 1'b0;
+      stall_q      <= stall_timeout - TS_ONE;
+      stall_zero_q <= (stall_timeout == TS_ONE);
+      stalled_q    <= 1'b0;
     end else if (tick & ~stalled_q) begin
-      stall_q   <= stall_q - TS_ONE;
-      stalled_q <= stall_hit;
+      stall_q      <= stall_q - TS_ONE;
+      stall_zero_q <= (stall_q == TS_ONE);
+      stalled_q    <= stall_hit;
     end
   end
 

@@ -9,8 +9,10 @@
 `default_nettype none
 
 module enc_qei_wb #(
-    parameter integer COUNT_W = 32,  // counter width: 8 .. 64
-    parameter integer TS_W    = 32   // timebase / timestamp width: 16 .. 32
+    parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
+    parameter integer TS_W       = 32,  // timebase / timestamp width: 16 .. 32
+    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only (see enc_qei)
+    parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,       // synchronous, active high
@@ -49,13 +51,29 @@ module enc_qei_wb #(
       $error("enc_qei_wb: parameter TS_W must be in 16 .. 32");
 `endif
     end
+    if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile
+`ifdef __ICARUS__
+      enc_qei_wb__parameter_PROFILE_must_be_1_to_2 u_stop ();
+`else
+      $error("enc_qei_wb: parameter PROFILE must be in 1 .. 2");
+`endif
+    end
+    if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask
+`ifdef __ICARUS__
+      enc_qei_wb__parameter_FUNC_MASK_must_be_1_to_511 u_stop ();
+`else
+      $error("enc_qei_wb: parameter FUNC_MASK must be in 1 .. 511");
+`endif
+    end
   endgenerate
 
   wire resp_valid, resp_err;
 
   enc_qei #(
-      .COUNT_W(COUNT_W),
-      .TS_W   (TS_W)
+      .COUNT_W   (COUNT_W),
+      .TS_W      (TS_W),
+      .PROFILE   (PROFILE),
+      .FUNC_MASK (FUNC_MASK)
   ) u_qei (
       .clk       (clk),
       .rst       (rst),

@@ -26,6 +26,11 @@ Field kinds the Verilog generator understands (anything else stops it with a mes
                          <reg>_rdata on the byte lanes not enabled)
 User property sized_by ("COUNT_W:0", "COUNT_W:1", "TS_W"): storage keeps only the bits of the
 value; the others read 0 and ignore writes.
+User property feature (on a register, e.g. "TIMING"): a module parameter of that name (default 1);
+with 0 the register reads 0, ignores writes, its outputs are 0 (its storage is left out) and it
+still answers without an error.
+User property fixed_by (on a cfg field, e.g. "FIXED_FUNC"): a module parameter of that name
+(default -1); when >= 0 the field reads and outputs that value and ignores writes.
 """
 
 from __future__ import annotations
@@ -82,6 +87,9 @@ def vname(*parts: str) -> str:
 
 def verilog(top) -> str:
     regs = list(top.registers())
+    features = sorted({r.get_property("feature") for r in regs if r.get_property("feature")})
+    fixers = sorted({f.get_property("fixed_by") for r in regs for f in r.fields()
+                     if f.get_property("fixed_by")})
     ports: list[str] = []
     body: list[str] = []
     rd_cases: list[str] = []
@@ -90,6 +98,9 @@ def verilog(top) -> str:
     for r in regs:
         idx = r.address_offset >> 2
         rn = r.inst_name
+        feat = r.get_property("feature")
+        if feat and r.external:
+            raise SystemExit(f"gen_regs: external register {rn} cannot have a feature")
         addr_params.append(f"  localparam [5:0] A_{rn} = 6'd{idx};  // 0x{r.address_offset:02X}")
         rd_lines: list[str] = []
         if r.external:
@@ -129,7 +140,14 @@ def verilog(top) -> str:
                 q = f"{name}_q"
                 body.append(f"  reg {rng}{q};  // {desc}")
                 ports.append(f"    output wire {rng}{name},  // {desc}")
-                body.append(f"  assign {name} = {q};")
+                fix = f.get_property("fixed_by")
+                if fix and kind != "cfg":
+                    raise SystemExit(f"gen_regs: fixed_by on {desc}: only for sw=rw hw=r fields")
+                rdval = q
+                if fix:
+                    rdval = f"(({fix} >= 0) ? {fix}[{w - 1}:0] : {q})"
+                val = f"(({feat} != 0) ? {rdval} : {w}'d0)" if feat else rdval
+                body.append(f"  assign {name} = {val};")
                 wr = f"wr_req & (req_addr[7:2] == A_{rn})"
                 body.append("  always @(posedge clk) begin")
                 body.append(f"    if (rst) begin")
@@ -159,21 +177,29 @@ def verilog(top) -> str:
                 body.append("    end")
                 body.append("  end")
                 body.append("")
-                rd_lines.append(f"        rd_d{sl} = {q};")
+                rd_lines.append(f"        rd_d{sl} = {rdval};")
             elif kind == "pulse":
                 q = f"{name}_q"
                 body.append(f"  reg {rng}{q};  // {desc}: one-clock pulse")
                 ports.append(f"    output wire {rng}{name},  // {desc}: one-clock pulse on a write of 1")
-                body.append(f"  assign {name} = {q};")
+                body.append(f"  assign {name} = " + (f"(({feat} != 0) ? {q} : {w}'d0);" if feat else f"{q};"))
                 body.append("  always @(posedge clk) begin")
+                # (an if, not an AND with the strobe: an unknown request in simulation leaves 0)
                 body.append(f"    if (rst) {q} <= {w}'d0;")
-                body.append(f"    else {q} <= {{{w}{{wr_req & (req_addr[7:2] == A_{rn})}}}} & "
-                            f"req_wdata{sl} & {wmask};")
+                body.append(f"    else if (wr_req & (req_addr[7:2] == A_{rn})) {q} <= req_wdata{sl} & {wmask};")
+                body.append(f"    else {q} <= {w}'d0;")
                 body.append("  end")
                 body.append("")
             else:
                 raise AssertionError(kind)
+        if feat and rd_lines:
+            rd_lines = [f"        if ({feat} != 0) begin"] + ["  " + l for l in rd_lines] + ["        end"]
         rd_cases.append((rn, rd_lines))
+
+    params = [f"    parameter integer {p} = 1,  // 1: {p.lower()} registers present, 0: read 0 (checked by enc_qei)"
+              for p in features]
+    params += [f"    parameter integer {p} = -1,  // -1: the field is storage, >= 0: fixed to it (checked by enc_qei)"
+               for p in fixers]
 
     lines = [
         "// SPDX-License-Identifier: Apache-2.0",
@@ -190,6 +216,7 @@ def verilog(top) -> str:
         "`default_nettype none",
         "",
         "module enc_qei_regs #(",
+        *params,
         "    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)",
         "    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)",
         ") (",
@@ -274,9 +301,11 @@ def verilog(top) -> str:
 
 
 def c_header(top, path: Path) -> None:
+    from peakrdl_cheader.c_standards import CStandard
     from peakrdl_cheader.exporter import CHeaderExporter
 
-    CHeaderExporter().export(top, str(path))
+    # gnu99: valid C99 with GNU extensions (no C11 static_assert); gcc -std=c99 and later accept it
+    CHeaderExporter().export(top, str(path), std=CStandard.gnu99)
     text = path.read_text()
     # peakrdl-cheader gives masks, positions and the register struct; add byte offsets and the
     # enum values (it exports neither) inside the include guard.

@@ -10,7 +10,6 @@
 extern "C" {
 #endif
 #include <stdint.h>
-#include <assert.h>
 
 // reg - enc_qei::ID
 #define ENC_QEI__ID__VERSION_bm 0xffff
@@ -433,7 +432,6 @@ typedef struct __attribute__ ((__packed__)) {
 } enc_qei_t;
 
 
-static_assert(sizeof(enc_qei_t) == 0x90, "Packing error");
 
 
 // Register byte offsets

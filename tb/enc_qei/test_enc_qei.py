@@ -695,7 +695,7 @@ class ClockTrace:
     a snapshot's values can be checked to come from one and the same clock."""
 
     def __init__(self, dut):
-        core, timing = dut.u_qei.u_core, dut.u_qei.u_timing
+        core, timing = dut.u_qei.u_core, dut.u_qei.g_timing.u_timing
         self.sig = (core.count_q, timing.tb_q, core.edge_any, core.edge_a_rise)
         self.count, self.tb, self.any, self.arise = [], [], [], []
         self.task = cocotb.start_soon(self._run(dut))
