@@ -1,0 +1,591 @@
+// SPDX-License-Identifier: Apache-2.0
+// Formal wrapper for enc_qei_core (read by formal/enc_qei_core.sby; `make formal`).
+//
+// Port-level only: the core is instantiated with named ports and nothing inside it is referenced,
+// so its internals may change as long as its ports and their cycle timing do not. The only
+// assumption (outside the X4FREE task) is that the first clock is a reset; every input, rst
+// included, is free after that: FUNC, RANGE, CEILING, SWAP/INV, EN, COUNT writes and index
+// controls may change at any clock.
+//
+// The wrapper keeps a reference model written from the header of rtl/enc_qei_core.v, the enc_qei
+// section of the module contract and the register descriptions of rtl/enc_qei.rdl:
+//   sample s (clock t)  channels after SWAP_AB / INV_A / INV_B; the decoders are held in reset
+//                       while rst, !valid, or {FUNC, SWAP_AB, INV_A, INV_B} differs from its value
+//                       of the clock before (that value is cleared by rst, the CTRL reset value);
+//                       the first sample out of that reset is the reference, not counted
+//   clock t + 1         the count function's step of sample s (x4, x2a, x2b, x1a, x1b, pulse_dir,
+//                       increase, decrease) and ev_qerr (both channels changed; quadrature
+//                       functions only)
+//   clock t + 2         step_up / step_dn (gated by EN of clock t + 1), edge_any / edge_a_rise and
+//                       the index hit of sample s (ev_index); the range applies the step: the
+//                       count, STOPPED, applied_up/dn, overflow/underflow are those of this clock
+//   clock t + 3         count shows it; ev_cmp / cmp_out one clock later if it equals COMPARE
+// x1_hyst (Figure 14) is proven in formal/enc_x1_hysteresis.sby; here its steps are taken from the
+// core's step ports (only "never both" and EN gating are checked), the range model still applies
+// them independently.
+// Index: Z after INV_Z, qualified by the (A, B) gate, edge detector held in reset by rst | !valid,
+// its hit in clock t + 2 (with the step of the same sample); an armed preset wins over the step, a
+// latch stores the count after the step. Probe: edge of probe_c, hit one clock after the sample
+// (held in reset likewise), latches the count and the timebase of that clock.
+// Checked: count, STOPPED, dir, COUNT_LO/HI read data, step and edge outputs, every event output
+// (overflow, underflow, index, probe, cmp, qerr, dir_change), applied_up/dn, idx_armed,
+// idx_disarm, probe_disarm, INDEX_LATCH, PROBE_LATCH and PROBE_TIME equal the model at every
+// clock; plus model-free one-step properties (applied steps move the count by exactly one in the
+// range; the count changes only by a step, a COUNT_LO write or an index preset; a bounded range is
+// never left; non_recycle stays stopped until a COUNT_LO write) and, with COUNT_W > 32, LO/HI
+// coherence. Task X4FREE (define) assumes x4, free range, EN, no COUNT write, no index preset and
+// checks count == a plain 4X position of the sample stream directly.
+// Defines: PIPE_ONLY keeps only what does not depend on the count register (k-induction closes on
+// it from the ports alone); the count's induction needs the core's internal zero_q flag to agree
+// with count_q, an invariant the ports cannot show, so those properties run bounded (see the .sby).
+// NO_LATCHES drops the latch checks (COUNT_W 40 tasks); HI_STAGED assumes each COUNT_LO write
+// follows a COUNT_HI write (for a COUNT_W 40 induction: the staged word is invisible otherwise).
+`default_nettype none
+
+module enc_qei_core_formal #(
+    parameter integer COUNT_W = 8,
+    parameter integer TS_W    = 16
+) (
+    input wire               clk,
+    input wire               rst,
+    input wire               a_c,
+    input wire               b_c,
+    input wire               z_c,
+    input wire               probe_c,
+    input wire               valid,
+    input wire               en,
+    input wire               swap_ab,
+    input wire               inv_a,
+    input wire               inv_b,
+    input wire               inv_z,
+    input wire [3:0]         func,
+    input wire [1:0]         range,
+    input wire [COUNT_W-1:0] preset,
+    input wire [COUNT_W-1:0] ceiling,
+    input wire [COUNT_W-1:0] compare,
+    input wire [1:0]         idx_action,
+    input wire               idx_oneshot,
+    input wire               idx_edge,
+    input wire               idx_gate_en,
+    input wire               idx_gate_a,
+    input wire               idx_gate_b,
+    input wire               idx_arm,
+    input wire               probe_en,
+    input wire               probe_edge,
+    input wire               probe_once,
+    input wire [TS_W-1:0]    timebase,
+    input wire               count_lo_rd,
+    input wire               count_lo_wr,
+    input wire [31:0]        count_lo_wdata,
+    input wire               count_hi_wr,
+    input wire [31:0]        count_hi_wdata
+);
+
+  wire [31:0]        count_lo_rdata;
+  wire [31:0]        count_hi_rdata;
+  wire [COUNT_W-1:0] count;
+  wire [COUNT_W-1:0] idx_latch;
+  wire [COUNT_W-1:0] probe_latch;
+  wire [TS_W-1:0]    probe_time;
+  wire a_eff, b_eff, z_eff, dir, idx_armed, stopped, idx_disarm, probe_disarm;
+  wire step_up, step_dn, applied_up, applied_dn, edge_any, edge_a_rise;
+  wire ev_overflow, ev_underflow, ev_index, ev_probe, ev_cmp, ev_qerr, ev_dir_change, cmp_out;
+
+  enc_qei_core #(
+      .COUNT_W(COUNT_W),
+      .TS_W   (TS_W)
+  ) dut (
+      .clk           (clk),
+      .rst           (rst),
+      .a_c           (a_c),
+      .b_c           (b_c),
+      .z_c           (z_c),
+      .probe_c       (probe_c),
+      .valid         (valid),
+      .en            (en),
+      .swap_ab       (swap_ab),
+      .inv_a         (inv_a),
+      .inv_b         (inv_b),
+      .inv_z         (inv_z),
+      .func          (func),
+      .range         (range),
+      .preset        (preset),
+      .ceiling       (ceiling),
+      .compare       (compare),
+      .idx_action    (idx_action),
+      .idx_oneshot   (idx_oneshot),
+      .idx_edge      (idx_edge),
+      .idx_gate_en   (idx_gate_en),
+      .idx_gate_a    (idx_gate_a),
+      .idx_gate_b    (idx_gate_b),
+      .idx_arm       (idx_arm),
+      .probe_en      (probe_en),
+      .probe_edge    (probe_edge),
+      .probe_once    (probe_once),
+      .timebase      (timebase),
+      .count_lo_rd   (count_lo_rd),
+      .count_lo_wr   (count_lo_wr),
+      .count_lo_wdata(count_lo_wdata),
+      .count_hi_wr   (count_hi_wr),
+      .count_hi_wdata(count_hi_wdata),
+      .count_lo_rdata(count_lo_rdata),
+      .count_hi_rdata(count_hi_rdata),
+      .count         (count),
+      .idx_latch     (idx_latch),
+      .probe_latch   (probe_latch),
+      .probe_time    (probe_time),
+      .a_eff         (a_eff),
+      .b_eff         (b_eff),
+      .z_eff         (z_eff),
+      .dir           (dir),
+      .idx_armed     (idx_armed),
+      .stopped       (stopped),
+      .idx_disarm    (idx_disarm),
+      .probe_disarm  (probe_disarm),
+      .step_up       (step_up),
+      .step_dn       (step_dn),
+      .applied_up    (applied_up),
+      .applied_dn    (applied_dn),
+      .edge_any      (edge_any),
+      .edge_a_rise   (edge_a_rise),
+      .ev_overflow   (ev_overflow),
+      .ev_underflow  (ev_underflow),
+      .ev_index      (ev_index),
+      .ev_probe      (ev_probe),
+      .ev_cmp        (ev_cmp),
+      .ev_qerr       (ev_qerr),
+      .ev_dir_change (ev_dir_change),
+      .cmp_out       (cmp_out)
+  );
+
+  localparam [3:0] F_X4 = 4'd0, F_X2A = 4'd1, F_X2B = 4'd2, F_X1A = 4'd3, F_X1B = 4'd4,
+                   F_PULSE_DIR = 4'd5, F_INCREASE = 4'd6, F_DECREASE = 4'd7, F_X1_HYST = 4'd8;
+  localparam [1:0] R_FREE = 2'd0, R_MODULO = 2'd1, R_LIMIT = 2'd2, R_NON_RECYCLE = 2'd3;
+  localparam [1:0] I_PRESET = 2'd1;
+  localparam [COUNT_W-1:0] ONE = {{(COUNT_W-1){1'b0}}, 1'b1};
+  localparam [COUNT_W-1:0] ZERO = {COUNT_W{1'b0}};
+  localparam [COUNT_W-1:0] ALL1 = {COUNT_W{1'b1}};
+
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+
+  always @(*) begin
+    if (!f_past_valid) assume (rst);
+  end
+
+`ifdef X4FREE
+  // Task prove_x4free: x4, free range, counting enabled, no COUNT write, no index preset.
+  always @(*) begin
+    assume (func == F_X4 && range == R_FREE && en && !count_lo_wr && idx_action != I_PRESET);
+  end
+`endif
+
+`ifdef HI_STAGED
+  // Task prove_w40: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
+  // is internal state the ports do not show until a COUNT_LO write uses it; this keeps it known
+  // to the induction). bmc_w40 checks writes without this assumption, to a bounded depth.
+  always @(*) begin
+    if (f_past_valid && count_lo_wr) assume (f_hi_wr_q);
+  end
+`endif
+  reg f_hi_wr_q = 1'b0;
+  always @(posedge clk) f_hi_wr_q <= count_hi_wr;
+
+  // ---- sample level (clock t) ----------------------------------------------------------------------
+  wire       f_a = (swap_ab ? b_c : a_c) ^ inv_a;
+  wire       f_b = (swap_ab ? a_c : b_c) ^ inv_b;
+  wire       f_z = z_c ^ inv_z;
+  wire [6:0] f_cfg = {func, swap_ab, inv_a, inv_b};
+  reg  [6:0] f_cfg_q = 7'd0;  // the clock before (cleared by rst)
+  wire       f_drst = rst | ~valid | (f_cfg != f_cfg_q);  // decoders held in reset
+
+  reg        f_ref = 1'b0;      // the previous sample is a real one (decoders out of reset)
+  reg  [1:0] f_prev = 2'b00;    // previous {a, b}
+  wire       f_ach = f_a ^ f_prev[1];
+  wire       f_bch = f_b ^ f_prev[0];
+  wire       f_valid = ~f_drst & f_ref & (f_ach ^ f_bch);  // a valid transition at this sample
+  wire       f_illegal = ~f_drst & f_ref & f_ach & f_bch;  // both channels changed
+  wire       f_fwd = ({f_a, f_b} == {~f_prev[0], f_prev[1]});  // 00 -> 10 -> 11 -> 01 -> 00
+  wire       f_arise = ~f_drst & f_ref & f_a & ~f_prev[1];   // A rising (pulse functions)
+
+  // index: Z qualified by the gate; edge detector held in reset by rst | !valid only
+  wire       f_iq = f_z & (~idx_gate_en | ((f_a == idx_gate_a) & (f_b == idx_gate_b)));
+  reg        f_iprev = 1'b0, f_iok = 1'b0, f_ihit1 = 1'b0, f_ihit = 1'b0;
+
+  // stage 1: the decoders' view of the sample, one clock later
+  reg f1_valid = 1'b0, f1_illegal = 1'b0, f1_fwd = 1'b0, f1_amov = 1'b0, f1_bmov = 1'b0;
+  reg f1_a = 1'b0, f1_b = 1'b0, f1_arise = 1'b0;
+
+  always @(posedge clk) begin
+    f_cfg_q    <= rst ? 7'd0 : f_cfg;
+    f_ref      <= ~f_drst;
+    f_prev     <= {f_a, f_b};
+    f1_valid   <= f_valid;
+    f1_illegal <= f_illegal;
+    f1_fwd     <= f_fwd;
+    f1_amov    <= f_ach;
+    f1_bmov    <= f_bch;
+    f1_a       <= f_a;
+    f1_b       <= f_b;
+    f1_arise   <= f_arise;
+    if (rst | ~valid) begin
+      f_iprev <= 1'b0;
+      f_iok   <= 1'b0;
+      f_ihit1 <= 1'b0;
+      f_ihit  <= 1'b0;
+    end else begin
+      f_iprev <= f_iq;
+      f_iok   <= 1'b1;
+      f_ihit1 <= f_iok & (idx_edge ? (f_iprev & ~f_iq) : (~f_iprev & f_iq));
+      f_ihit  <= f_ihit1;
+    end
+  end
+
+  // ---- stage 1 (clock t + 1): the count function -----------------------------------------------------
+  reg f_fup, f_fdn, f_quad;
+  always @(*) begin
+    f_fup  = 1'b0;
+    f_fdn  = 1'b0;
+    f_quad = 1'b0;
+    case (func)
+      F_X4: begin
+        f_fup = f1_valid & f1_fwd;
+        f_fdn = f1_valid & ~f1_fwd;
+        f_quad = 1'b1;
+      end
+      F_X2A: begin  // both edges of A
+        f_fup = f1_valid & f1_amov & f1_fwd;
+        f_fdn = f1_valid & f1_amov & ~f1_fwd;
+        f_quad = 1'b1;
+      end
+      F_X2B: begin
+        f_fup = f1_valid & f1_bmov & f1_fwd;
+        f_fdn = f1_valid & f1_bmov & ~f1_fwd;
+        f_quad = 1'b1;
+      end
+      F_X1A: begin  // +1 on A rising forward, -1 on A falling backward
+        f_fup = f1_valid & f1_amov & f1_fwd & f1_a;
+        f_fdn = f1_valid & f1_amov & ~f1_fwd & ~f1_a;
+        f_quad = 1'b1;
+      end
+      F_X1B: begin
+        f_fup = f1_valid & f1_bmov & f1_fwd & f1_b;
+        f_fdn = f1_valid & f1_bmov & ~f1_fwd & ~f1_b;
+        f_quad = 1'b1;
+      end
+      F_PULSE_DIR: begin  // A rising, B = direction (1 = up)
+        f_fup = f1_arise & f1_b;
+        f_fdn = f1_arise & ~f1_b;
+      end
+      F_INCREASE: f_fup = f1_arise;
+      F_DECREASE: f_fdn = f1_arise;
+      F_X1_HYST: f_quad = 1'b1;  // steps: see f_hyst_q
+      default: ;
+    endcase
+  end
+
+  // stage 2 registers
+  reg f2_up = 1'b0, f2_dn = 1'b0, f2_edge = 1'b0, f2_arise_edge = 1'b0, f_hyst_q = 1'b0;
+  always @(posedge clk) begin
+    if (rst) begin
+      f2_up         <= 1'b0;
+      f2_dn         <= 1'b0;
+      f2_edge       <= 1'b0;
+      f2_arise_edge <= 1'b0;
+      f_hyst_q      <= 1'b0;
+    end else begin
+      f2_up         <= en & f_fup;
+      f2_dn         <= en & f_fdn;
+      f2_edge       <= f1_valid;
+      f2_arise_edge <= f1_valid & f1_amov & f1_a;
+      f_hyst_q      <= en & (func == F_X1_HYST);
+    end
+  end
+
+  // ---- stage 2 (clock t + 2): the range applies the step -----------------------------------------
+  wire f_su = f_hyst_q ? step_up : f2_up;  // the step this clock (x1_hyst: the core's)
+  wire f_sd = f_hyst_q ? step_dn : f2_dn;
+
+  reg  [COUNT_W-1:0] f_count = {COUNT_W{1'b0}};
+  reg                f_stopped = 1'b0;
+  reg                f_dir = 1'b1;
+  reg  [31:0]        f_hi_stage = 32'd0;
+  reg  [31:0]        f_hi_latch = 32'd0;
+  reg                f_upd_q = 1'b0;
+  reg                f_cmp = 1'b0;
+
+  wire f_at_zero = (f_count == ZERO);
+  wire f_at_ceil = (f_count >= ceiling);
+  reg  [COUNT_W-1:0] f_stepped;
+  reg  f_ovf, f_unf, f_took, f_stop_d;
+
+  always @(*) begin
+    f_stepped = f_count;
+    f_ovf     = 1'b0;
+    f_unf     = 1'b0;
+    f_took    = 1'b0;
+    f_stop_d  = f_stopped;
+    if (f_su) begin
+      case (range)
+        R_FREE: begin
+          f_stepped = f_count + ONE;
+          f_ovf = (f_count == ALL1);
+          f_took = 1'b1;
+        end
+        R_MODULO: begin
+          f_stepped = f_at_ceil ? ZERO : f_count + ONE;
+          f_ovf = f_at_ceil;
+          f_took = 1'b1;
+        end
+        default: begin  // limit, non_recycle (while not stopped)
+          if (range == R_LIMIT || !f_stopped) begin
+            f_stepped = f_at_ceil ? f_count : f_count + ONE;
+            f_ovf = f_at_ceil;
+            f_took = ~f_at_ceil;
+            if (range == R_NON_RECYCLE) f_stop_d = f_at_ceil;
+          end
+        end
+      endcase
+    end else if (f_sd) begin
+      case (range)
+        R_FREE: begin
+          f_stepped = f_count - ONE;
+          f_unf = f_at_zero;
+          f_took = 1'b1;
+        end
+        R_MODULO: begin
+          f_stepped = f_at_zero ? ceiling : f_count - ONE;
+          f_unf = f_at_zero;
+          f_took = 1'b1;
+        end
+        default: begin
+          if (range == R_LIMIT || !f_stopped) begin
+            f_stepped = f_at_zero ? f_count : f_count - ONE;
+            f_unf = f_at_zero;
+            f_took = ~f_at_zero;
+            if (range == R_NON_RECYCLE) f_stop_d = f_at_zero;
+          end
+        end
+      endcase
+    end
+    if (count_lo_wr) f_stop_d = 1'b0;  // a COUNT write releases non_recycle
+  end
+
+  wire               f_armed = idx_arm & (idx_action != 2'd0);
+  wire               f_preset = f_ihit & f_armed & (idx_action == I_PRESET);
+  wire               f_load = count_lo_wr | f_preset;
+  wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};
+  wire [COUNT_W-1:0] f_wr = f_wr64[COUNT_W-1:0];
+  wire [COUNT_W-1:0] f_next = count_lo_wr ? f_wr : f_preset ? preset : f_stepped;
+  wire [63:0]        f_count64 = {{(64 - COUNT_W) {1'b0}}, f_count};
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_count    <= ZERO;
+      f_stopped  <= 1'b0;
+      f_dir      <= 1'b1;
+      f_hi_stage <= 32'd0;
+      f_hi_latch <= 32'd0;
+      f_upd_q    <= 1'b0;
+      f_cmp      <= 1'b0;
+    end else begin
+      f_count   <= f_next;
+      f_stopped <= f_stop_d;
+      if (f_su | f_sd) f_dir <= f_su;
+      if (count_hi_wr) f_hi_stage <= count_hi_wdata;
+      if (count_lo_rd) f_hi_latch <= f_count64[63:32];
+      f_upd_q   <= f_load | f_took;  // the count was set (changed or reloaded) at this edge
+      f_cmp     <= f_upd_q & (f_count == compare);
+    end
+  end
+
+`ifndef NO_LATCHES
+  // ---- latches: INDEX_LATCH (the count after the transition's step), probe (latency 1) ---------
+  // (left out of the COUNT_W 40 tasks by NO_LATCHES: there they slowed the solver from seconds to
+  // more than ten minutes; the logic does not depend on the width)
+  reg  f_pprev = 1'b0, f_pok = 1'b0, f_phit = 1'b0;
+  reg  [COUNT_W-1:0] f_idx_latch = {COUNT_W{1'b0}}, f_probe_latch = {COUNT_W{1'b0}};
+  reg  [TS_W-1:0]    f_probe_time = {TS_W{1'b0}};
+  wire f_ilatch = f_ihit & f_armed & (idx_action == 2'd2);
+  always @(posedge clk) begin
+    if (rst | ~valid) begin
+      f_pprev <= 1'b0;
+      f_pok   <= 1'b0;
+      f_phit  <= 1'b0;
+    end else begin
+      f_pprev <= probe_c;
+      f_pok   <= 1'b1;
+      f_phit  <= f_pok & probe_en & (probe_edge ? (f_pprev & ~probe_c) : (~f_pprev & probe_c));
+    end
+    if (rst) begin
+      f_idx_latch   <= ZERO;
+      f_probe_latch <= ZERO;
+      f_probe_time  <= {TS_W{1'b0}};
+    end else begin
+      if (f_ilatch) f_idx_latch <= f_stepped;
+      if (f_phit) begin
+        f_probe_latch <= f_count;
+        f_probe_time  <= timebase;
+      end
+    end
+  end
+
+`endif
+
+  // ---- properties: the core equals the model at every clock ---------------------------------------
+  always @(*) begin
+    if (f_past_valid) begin
+      assert (a_eff == f_a && b_eff == f_b && z_eff == f_z);
+      assert (ev_qerr == (f_quad & f1_illegal));
+      assert (!(step_up && step_dn));
+      if (!f_hyst_q) assert (step_up == f2_up && step_dn == f2_dn);
+      assert (edge_any == f2_edge && edge_a_rise == f2_arise_edge);
+      assert (ev_index == f_ihit);
+      assert (idx_armed == f_armed);
+      assert (idx_disarm == (f_ihit & f_armed & idx_oneshot));
+`ifndef PIPE_ONLY
+      assert (count == f_count);
+      assert (stopped == f_stopped);
+`endif
+      assert (dir == f_dir);
+`ifndef PIPE_ONLY
+      assert (applied_up == (f_took & f_su & ~f_load));
+      assert (applied_dn == (f_took & f_sd & ~f_load));
+      assert (ev_overflow == f_ovf && ev_underflow == f_unf);
+`endif
+      assert (ev_dir_change == ((f_su & ~f_dir) | (f_sd & f_dir)));
+`ifndef PIPE_ONLY
+      assert (ev_cmp == f_cmp && cmp_out == f_cmp);
+      // COUNT_LO reads the count's low word; COUNT_HI what the last COUNT_LO read latched
+      assert (count_lo_rdata == f_count64[31:0]);
+      assert (count_hi_rdata == f_hi_latch);
+`endif
+`ifndef NO_LATCHES
+      assert (ev_probe == f_phit && probe_disarm == (f_phit & probe_once));
+      assert (probe_time == f_probe_time);
+`ifndef PIPE_ONLY
+      assert (idx_latch == f_idx_latch);
+      assert (probe_latch == f_probe_latch);
+`endif
+`endif
+      if (COUNT_W <= 32) assert (count_hi_rdata == 32'd0);
+    end
+  end
+
+`ifndef PIPE_ONLY
+  // ---- model-free one-step properties ---------------------------------------------------------------
+  always @(posedge clk) begin
+    if (f_past_valid && !$past(rst)) begin
+      // an applied step moves the count by exactly one, in the range
+      if ($past(applied_up))
+        assert (count == (($past(range) == R_MODULO && $past(count) >= $past(ceiling)) ? ZERO :
+                          $past(count) + ONE));
+      if ($past(applied_dn))
+        assert (count == (($past(range) == R_MODULO && $past(count) == ZERO) ? $past(ceiling) :
+                          $past(count) - ONE));
+      assert (!$past(applied_up && applied_dn));
+      // the count changes only by a step, a COUNT_LO write or an index preset
+      if (!$past(applied_up || applied_dn || count_lo_wr || f_preset)) assert (count == $past(count));
+      if ($past(count_lo_wr)) assert (count == $past(f_wr));
+      // a bounded range is never left by counting
+      if ($past(range) != R_FREE && $past(count) <= $past(ceiling) && !$past(f_load))
+        assert (count <= $past(ceiling));
+      // limit / non_recycle: never past the bounds, the stop raises the event and is no step
+      if ($past(range) == R_LIMIT || $past(range) == R_NON_RECYCLE) begin
+        if ($past(step_up) && $past(count) >= $past(ceiling))
+          assert (!$past(applied_up) && $past(ev_overflow) == ($past(range) == R_LIMIT || !$past(stopped)));
+        if ($past(step_dn) && !$past(step_up) && $past(count) == ZERO)
+          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(range) == R_LIMIT || !$past(stopped)));
+      end
+      // non_recycle: stopped stays stopped (and the count still) until a COUNT_LO write
+      if ($past(stopped) && !$past(count_lo_wr)) assert (stopped);
+      if ($past(stopped) && $past(range) == R_NON_RECYCLE && !$past(f_load))
+        assert (count == $past(count) && !$past(applied_up || applied_dn));
+      if ($past(count_lo_wr)) assert (!stopped);
+    end
+  end
+
+`endif
+
+  // ---- LO/HI coherence (meaningful with COUNT_W > 32) ----------------------------------------------
+  reg [63:0] f_read = 64'd0;  // the count as of the last COUNT_LO read (0 after rst)
+  always @(posedge clk) begin
+    if (rst) f_read <= 64'd0;
+    else if (count_lo_rd) f_read <= f_count64;
+  end
+  always @(*) begin
+    if (f_past_valid) begin
+`ifdef PIPE_ONLY
+      if (COUNT_W <= 32) assert (count_hi_rdata == 32'd0);
+`else
+      assert (count_hi_rdata == f_read[63:32]);
+      if (count_lo_rd) assert ({32'd0, count_lo_rdata} == {32'd0, f_count64[31:0]});
+`endif
+    end
+  end
+
+`ifdef X4FREE
+  // ---- x4 in the free range: count == a plain 4X position of the sample stream ---------------------
+  // f_pos: +1 per forward valid transition, -1 per reverse one, illegal changes ignored, from the
+  // reference sample after each decoder reset; the count shows a sample 3 clocks later.
+  reg [COUNT_W-1:0] f_pos = {COUNT_W{1'b0}}, f_pos1 = {COUNT_W{1'b0}}, f_pos2 = {COUNT_W{1'b0}};
+  always @(posedge clk) begin
+    if (rst) begin
+      f_pos  <= ZERO;
+      f_pos1 <= ZERO;
+      f_pos2 <= ZERO;
+    end else begin
+      if (f_valid) f_pos <= f_fwd ? f_pos + ONE : f_pos - ONE;
+      f_pos1 <= f_pos;
+      f_pos2 <= f_pos1;
+    end
+  end
+  always @(*) begin
+    if (f_past_valid) assert (count == f_pos2);
+  end
+  always @(posedge clk) begin
+    cover (f_past_valid && count == 8'd3 && !rst);
+    cover (f_past_valid && count == ALL1 && !rst);
+  end
+`endif
+
+  // ---- covers: every property's situation is reached ---------------------------------------------
+  always @(posedge clk) begin
+    if (f_past_valid && !rst) begin
+      cover (func == F_X4 && range == R_FREE && applied_up && count == ONE);
+      cover (func == F_X4 && range == R_FREE && applied_dn && count == ZERO);
+      cover (range == R_FREE && ev_overflow && applied_up);
+      cover (range == R_FREE && ev_underflow && applied_dn);
+      cover (range == R_MODULO && ev_overflow && applied_up && count != ZERO);
+      cover (range == R_MODULO && ev_underflow && applied_dn && ceiling != ALL1);
+      cover (range == R_LIMIT && ev_overflow && step_up && count == ceiling && ceiling != ALL1);
+      cover (range == R_LIMIT && ev_underflow && step_dn);
+      cover (range == R_NON_RECYCLE && ev_overflow && !stopped && ceiling != ALL1);
+      cover (range == R_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
+      cover ($past(stopped) && count_lo_wr && !rst);          // released by a COUNT_LO write
+      cover (ev_qerr && func == F_X4);
+      cover (ev_dir_change && step_dn);
+      cover (ev_dir_change && step_up);
+      cover (ev_cmp && $past(applied_up));
+      cover (ev_cmp && $past(count_lo_wr, 2));
+      cover (ev_cmp && $past(f_preset, 2));
+      cover (f_preset && (step_up | step_dn));                 // a preset wins over the step
+      cover (func == F_X2A && applied_dn);
+      cover (func == F_X2B && applied_up);
+      cover (func == F_X1A && applied_dn);
+      cover (func == F_X1B && applied_up);
+      cover (func == F_PULSE_DIR && applied_dn);
+      cover (func == F_INCREASE && applied_up);
+      cover (func == F_DECREASE && applied_dn);
+      cover (f_hyst_q && applied_up);
+      cover (count_lo_rd && count != ZERO);
+`ifndef NO_LATCHES
+      cover (f_ilatch && (step_up | step_dn));  // INDEX_LATCH takes the stepped count
+      cover (ev_probe && count != ZERO && probe_time != {TS_W{1'b0}});
+`endif
+    end
+  end
+
+endmodule
+
+`default_nettype wire
