@@ -131,15 +131,25 @@ module enc_conditioner_rt #(
     end
   end
 
-  // valid = settle_q[last5 + 1] (a loop, so the index needs no width of its own)
-  wire [4:0] valid_tap = last5 + 5'd1;
+  // valid = settle_q[last5 + 1], taken as a register of settle_q[last5] (the same value, one
+  // stage on: the tap's multiplexer is not in front of the decoders' reset; Fmax). A loop, so the
+  // index needs no width of its own.
+  reg        tap_d;
   reg        valid_d;
   integer    i;
 
   always @(*) begin
-    valid_d = 1'b0;
-    for (i = 0; i < SETTLE; i = i + 1) begin
-      if (valid_tap == i[4:0]) valid_d = settle_q[i];
+    tap_d = 1'b0;
+    for (i = 0; i < SETTLE - 1; i = i + 1) begin
+      if (last5 == i[4:0]) tap_d = settle_q[i];
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      valid_d <= 1'b0;
+    end else begin
+      valid_d <= tap_d;
     end
   end
 
