@@ -9,12 +9,19 @@ What it does:
      readings), slow down and reverse to -RPM/5, stop, creep to one transition of channel A and
      dither about it (the note's "stationary shaft oscillating slightly about a transition").
   3. Simulates tb/hdl/demo_top.v (conditioner, 1X Figure 14, 2X Figure 15, 4X look-up table,
-     Figure 17 BCD up/down buffer, Figure 11 phase meter, characterizer) with cocotb
-     (scripts/benches/demo_bench.py) at ``--clk-hz``, printing a progress line: on Icarus for short runs
-     (it starts at once), on Verilator for long ones (faster once its C++ build is done).
-  4. Prints one table: the true position against every count, the phase meter against the model's
-     true phase over the same cycles, the characterizer against the model, the narrowest state
-     against the decoder's limit, and a verdict per circuit. Exit status 1 if any verdict fails.
+     Figure 17 BCD up/down buffer, Figure 11 phase meter, characterizer, and the bus peripheral
+     enc_qei_wb) with cocotb (scripts/benches/demo_bench.py) at ``--clk-hz``, printing a progress
+     line: on Icarus for short runs (it starts at once), on Verilator for long ones (faster once
+     its C++ build is done). The bench reads enc_qei_wb over Wishbone as a host would: a snapshot
+     (SNAP_CTRL.CMD, SNAP_CTRL.EDGE = a_rising) every READ_TAU encoder cycles at the peak speed
+     (10 cycles: 400 us = 2.5 kHz at 3000 rpm, ~40 reads over the profile at any speed; the
+     issue's 1 kHz would give a handful in a 15 ms profile), and COUNT at the end.
+  4. Prints the position table: the true position against every count (enc_qei_wb's COUNT too),
+     the phase meter against the model's true phase over the same cycles, the characterizer
+     against the model, the narrowest state against the decoder's limit; then the velocity table:
+     per read the model's true speed, the timestamp (M/T, A-rising edges) and unit-time (M)
+     readings of hedsmodel.velocity on the registers, and the M/T error; then a verdict per
+     circuit. Exit status 1 if any verdict fails.
   5. Leaves sim/waves/demo.vcd and a GTKWave save file for it, sim/waves/demo.gtkw (``make
      waves`` opens both): sim/demo.gtkw's signals, opening on three encoder cycles at the peak
      speed of this run, markers A to D on the rising edges of A that bound them (``--gtkw`` to
@@ -83,6 +90,19 @@ CHAR_CNT_W = 16
 PM_MIN_CYCLES = 64         # phase meter contract: >= 64 cycles per window ...
 PM_MIN_CPC = 100           # ... and >= 100 clocks per cycle for its 0.25 degree accuracy
 PM_BOUND = 0.25
+# enc_qei_wb velocity (issue 13): reads, estimator and the two checks
+READ_TAU = 10.0            # a snapshot every 10 encoder cycles at the peak speed (tau each)
+STALL_TAU = 8.0            # STALL_TIMEOUT: 8 tau without a count edge (longer than a cycle at
+                           # -rpm/5, shorter than the stop's 5-tau rest after the last edge)
+VEL_EDGE = "a_rising"      # SNAP_CTRL.EDGE for the recommended M/T method
+VEL_TOL_PCT = 1.2          # M/T vs the true speed at constant speed: the encoder's own error floor
+                           # for M/T on A-rising edges is at most 1.17 % (worst modelled unit, one
+                           # cycle per reading; 0.3-0.4 % rms), doc/results/velocity_methods.md
+VEL_HW_TICKS = 2.0         # registers vs the same estimator on the model's exact edge times: each
+                           # timestamp is quantised to one clock, so a span is off by < 2 ticks
+VEL_MATCH_CLOCKS = 48      # a timestamp is at most this far behind its edge at the pins (the
+                           # synchroniser, filter and pipeline: ~FILTER_LEN + 5 clocks)
+VEL_SHOW_PCT = 5.0         # error % shown where |true speed| >= 5 % of the peak
 # Measured: Icarus runs demo_top at ~18k clocks/s and builds at once; Verilator ~150k clocks/s
 # after a ~20 s C++ build.
 ICARUS_MAX_CLOCKS = 350_000   # --sim auto takes Icarus up to here (~20 s), Verilator beyond
@@ -304,6 +324,24 @@ def make_plan(opts: Options) -> Plan:
     return Plan(opts, unit, wf, clk_ps, cpc, wl2, seg, int(m_edge), int(wf.positions[0]), amp, p)
 
 
+def tau_ns(plan: Plan) -> float:
+    """One encoder cycle at the peak speed, ns."""
+    return 1e9 / (plan.opts.rpm / 60.0 * CPR)
+
+
+def qei_reads_ns(plan: Plan) -> list:
+    """When the bench commands enc_qei_wb's snapshots: from the waveform start (the first read
+    only initialises the estimator) every READ_TAU cycles at the peak speed, to the profile's end."""
+    step = READ_TAU * tau_ns(plan)
+    end = plan.profile.duration_s * 1e9
+    return [k * step for k in range(int(end // step) + 1)]
+
+
+def qei_stall_ticks(plan: Plan) -> int:
+    """STALL_TIMEOUT in timebase ticks (TB_PRESCALE 0: one tick per clock)."""
+    return int(round(STALL_TAU * tau_ns(plan) * 1000.0 / plan.clk_ps))
+
+
 def write_plan(plan: Plan, path: Path) -> None:
     data = {
         "clk_ps": plan.clk_ps,
@@ -313,6 +351,8 @@ def write_plan(plan: Plan, path: Path) -> None:
         "hold_test_ns": plan.seg["hold"][0] + 0.5 * (plan.seg["hold"][1] - plan.seg["hold"][0]),
         "hold_test_clocks": int(5 * plan.cpc),
         "back_mid_ns": sum(plan.seg["back"]) / 2,
+        "qei": {"reads_ns": qei_reads_ns(plan), "edge": VEL_EDGE,
+                "stall_ticks": qei_stall_ticks(plan)},
     }
     path.write_text(json.dumps(data))
 
@@ -360,7 +400,10 @@ def simulate(plan: Plan, sim: str, name: str = NAME) -> dict:
     write_plan(plan, plan_file)
     params = {"FILTER_LEN": FILTER_LEN, "WINDOW_LOG2": plan.window_log2, "CNT_W": CHAR_CNT_W,
               "WINDOW_CYCLES": CHAR_CYCLES, "MIN_STATE": int(round(TEST_LIMIT_DEG * 256))}
-    sources = harness.rtl_sources() + [harness.TB_HDL / "demo_top.v"]
+    sys.path.insert(0, str(TB / "enc_qei"))
+    from qei_tb import extra_sources  # enc_qei's RTL files the core does not list (if any)
+
+    sources = harness.rtl_sources() + list(extra_sources()) + [harness.TB_HDL / "demo_top.v"]
     vcd.parent.mkdir(parents=True, exist_ok=True)
     vcd.unlink(missing_ok=True)
     if sim == "verilator":
@@ -502,6 +545,117 @@ def char_truth(plan: Plan, res: dict, valid_ps: float):
             "last_ns": (rises[-1] - res["t0_ps"]) / 1000}
 
 
+def _s32(x: int) -> int:
+    return x - (1 << 32) if x >= 1 << 31 else x
+
+
+def analyze_velocity(plan: Plan, res: dict) -> dict:
+    """enc_qei_wb's snapshots -> velocity rows and the two checks.
+
+    Every read gives a latched :class:`hedsmodel.velocity.Snapshot`; the project's estimator
+    turns the stream into M/T (SNAP_EDGE_DELTA / delta SNAP_EDGE_TIME, A-rising edges, with the
+    standstill rule and STATUS.STALLED) and M readings. Checks:
+
+    - *truth*: where the two A-rising edges of a M/T measurement and the read lie in a
+      constant-speed segment (hold, back), the reading is within VEL_TOL_PCT of the model's true
+      speed (what is left is the encoder's own error: cycle error and eccentricity);
+    - *registers*: every reading equals, within VEL_HW_TICKS of timestamp quantisation, the same
+      estimator on the same snapshots with each SNAP_EDGE_TIME replaced by the model's exact pin
+      time of that edge plus one constant (the median offset, i.e. the pipeline latency measured
+      here, whatever it is); SNAP_EDGE_DELTA equals the model's count between the two edges.
+
+    Each SNAP_EDGE_TIME is matched to the model's last A-rising edge at the pins before it (its
+    time in the simulation: the read's acknowledge less SNAP_TIME - SNAP_EDGE_TIME ticks; the
+    pipeline only delays it, by far less than a cycle)."""
+    import numpy as np
+    from hedsmodel.velocity import (EstimatorConfig, Snapshot, VelocityEstimator, counts_per_edge,
+                                    to_rpm, true_rpm)
+
+    q = res["qei"]
+    reads = q["reads"]
+    t0 = res["t0_ps"]
+    tick_ps = float(plan.clk_ps)           # TB_PRESCALE 0
+    tick_s = tick_ps * 1e-12
+    cpe = counts_per_edge(VEL_EDGE)
+    rises = _a_rises(plan.wf, t0)
+    rise_ps = np.array([t for t, _ in rises])
+    latched, pins, unmatched = [], [], 0
+    for r in reads:
+        s = Snapshot(count=r["SNAP_COUNT_LO"], time=r["SNAP_TIME"], edge_time=r["SNAP_EDGE_TIME"],
+                     delta=_s32(r["SNAP_DELTA"]), edge_delta=_s32(r["SNAP_EDGE_DELTA"]),
+                     stalled=r["stalled"])
+        latched.append(s)
+        e_ps = r["t_ack_ps"] - ((s.time - s.edge_time) % (1 << 32)) * tick_ps
+        j = int(np.searchsorted(rise_ps, e_ps + 0.5 * tick_ps, side="right")) - 1
+        if j < 0:
+            pins.append(None)              # no A-rising edge yet (SNAP_EDGE_TIME at reset)
+            unmatched += s.edge_time != 0
+        elif e_ps - rise_ps[j] > VEL_MATCH_CLOCKS * tick_ps:
+            pins.append(None)              # a timestamp long after any edge: matches none
+            unmatched += 1
+        else:
+            pins.append(j)
+    # one constant offset, ticks: SNAP_EDGE_TIME - pin time (the pipeline latency + the timebase's
+    # origin); the median, so no latency is assumed
+    offs = [latched[k].edge_time - rise_ps[j] / tick_ps for k, j in enumerate(pins) if j is not None]
+    off = float(np.median(offs)) if offs else 0.0
+    twin = [Snapshot(count=s.count, time=float(s.time),
+                     edge_time=(rise_ps[j] / tick_ps + off) if j is not None else float(s.edge_time),
+                     delta=s.delta, edge_delta=s.edge_delta, stalled=s.stalled)
+            for s, j in zip(latched, pins)]
+    est = VelocityEstimator(EstimatorConfig(tick_s=tick_s, ts_w=32, count_w=32, counts_per_edge=cpe))
+    est_x = VelocityEstimator(EstimatorConfig(tick_s=tick_s, ts_w=None, count_w=32, counts_per_edge=cpe))
+    rd, rdx = est.run(latched), est_x.run(twin)
+    t_s = np.array([(r["t_ack_ps"] - t0) * 1e-12 for r in reads])
+    truth = true_rpm(plan.profile, t_s)
+    const = {k: plan.seg[k] for k in ("hold", "back")}
+    pos = plan.wf.positions
+    rows, n_hw_bad, n_cnt_bad, n_cnt = [], 0, 0, 0
+    worst_hw, hw_allow_at_worst = 0.0, 0.0
+    prev_j = None
+    for k, (r, s, a, x) in enumerate(zip(reads, latched, rd, rdx)):
+        j = pins[k]
+        mt, mtx, m = to_rpm(a.mt), to_rpm(x.mt), to_rpm(a.m)
+        allow = VEL_HW_TICKS * tick_s * x.mt ** 2 / cpe + 1e-9 * abs(x.mt)   # counts/s
+        hw_ok = abs(a.mt - x.mt) <= allow
+        n_hw_bad += not hw_ok
+        if x.mt and abs(a.mt - x.mt) / abs(x.mt) > worst_hw:
+            worst_hw, hw_allow_at_worst = abs(a.mt - x.mt) / abs(x.mt), allow / abs(x.mt)
+        # SNAP_EDGE_DELTA against the model's count between the two matched edges
+        if k > 0 and j is not None and prev_j is not None:
+            n_cnt += 1
+            n_cnt_bad += s.edge_delta != pos[rises[j][1]] - pos[rises[prev_j][1]]
+        seg = next((n for n, (a0, b0) in plan.seg.items() if a0 <= t_s[k] * 1e9 < b0), "end")
+        checked = False
+        if k > 0 and s.edge_delta != 0 and j is not None and prev_j is not None:
+            e0, e1 = (rises[prev_j][0] - t0) / 1e3, (rises[j][0] - t0) / 1e3   # ns
+            for a0, b0 in const.values():
+                if a0 <= e0 and e1 <= b0 and a0 <= t_s[k] * 1e9 <= b0:
+                    checked = True
+        tr = float(truth[k])
+        err = (mt - tr) / abs(tr) * 100.0 if abs(tr) >= VEL_SHOW_PCT / 100 * plan.opts.rpm else None
+        rows.append(dict(k=k, t_ms=t_s[k] * 1e3, seg=seg, true=tr, mt=mt, mt_exact=mtx, m=m,
+                         err=err, edge_delta=s.edge_delta, stalled=s.stalled, checked=checked,
+                         ok=checked and err is not None and abs(err) <= VEL_TOL_PCT and mt != 0,
+                         hw_ok=hw_ok))
+        prev_j = j
+    chk = [r for r in rows if r["checked"]]
+    errs = np.array([r["err"] for r in chk if r["err"] is not None])
+    cnt = _s32(q["count"] & 0xFFFFFFFF)
+    p = plan.wf.final_position - plan.start_pos
+    ok = (cnt == p and n_hw_bad == 0 and n_cnt_bad == 0 and unmatched == 0 and chk
+          and all(r["ok"] for r in chk))
+    return dict(rows=rows, checked=len(chk), bad=sum(not r["ok"] for r in chk),
+                rms=float(np.sqrt(np.mean(errs ** 2))) if errs.size else float("nan"),
+                max=float(np.max(np.abs(errs))) if errs.size else float("nan"),
+                n_hw_bad=n_hw_bad, worst_hw=worst_hw * 100, hw_allow=hw_allow_at_worst * 100,
+                n_cnt=n_cnt, n_cnt_bad=n_cnt_bad, unmatched=unmatched, count=cnt, p=p, ok=bool(ok),
+                offset_ticks=off, stall_ticks=qei_stall_ticks(plan),
+                read_us=READ_TAU * tau_ns(plan) / 1e3, n_reads=len(reads),
+                zeros=sum(1 for r in rows if r["k"] > 0 and r["mt"] == 0
+                          and abs(r["true"]) >= VEL_SHOW_PCT / 100 * plan.opts.rpm))
+
+
 def analyze(plan: Plan, res: dict):
     """Rows of the table and the verdicts."""
     from hedsmodel import measure
@@ -613,8 +767,26 @@ def analyze(plan: Plan, res: dict):
                 f"all within {dev:.2f} <= {tol:.2f} deg (1 clock) of the model, "
                 f"{len(ch_rows)} window(s)" if ok else
                 f"off by {dev:.2f} deg (tolerance {tol:.2f}) or pass flag wrong")
+    # --- enc_qei_wb (count and velocity over the bus) --------------------------------------
+    vel = analyze_velocity(plan, res)
+    why = []
+    if vel["count"] != p:
+        why.append(f"COUNT {vel['count']} vs {p}")
+    if not vel["checked"]:
+        why.append("no M/T reading at constant speed")
+    elif vel["bad"]:
+        why.append(f"{vel['bad']} of {vel['checked']} M/T readings at constant speed off the true "
+                   f"speed by > {VEL_TOL_PCT:g} % (max {vel['max']:.2f} %)")
+    if vel["n_hw_bad"] or vel["n_cnt_bad"] or vel["unmatched"]:
+        why.append(f"registers vs the model's exact edges: {vel['n_hw_bad']} readings off by "
+                   f"> {VEL_HW_TICKS:g} ticks, {vel['n_cnt_bad']}/{vel['n_cnt']} SNAP_EDGE_DELTA "
+                   f"wrong, {vel['unmatched']} SNAP_EDGE_TIME matching no edge")
+    verdict("enc_qei_wb", vel["ok"],
+            f"COUNT = true 4X position; M/T within {vel['max']:.2f} <= {VEL_TOL_PCT:g} % of the "
+            f"true speed ({vel['checked']} constant-speed reads); all {vel['n_reads']} reads = "
+            f"model edges within {VEL_HW_TICKS:g} ticks" if vel["ok"] else "; ".join(why))
     return dict(p=p, p2=p2, m_all=m_all, pm_rows=pm_rows, pm_bound=bound, pm_in_contract=in_contract,
-                ch_rows=ch_rows, ch_tol=tol, verdicts=verdicts, min_clk=min_clk)
+                ch_rows=ch_rows, ch_tol=tol, verdicts=verdicts, min_clk=min_clk, vel=vel)
 
 
 def print_report(plan: Plan, res: dict, an: dict) -> None:
@@ -643,6 +815,7 @@ def print_report(plan: Plan, res: dict, an: dict) -> None:
     print(line)
     row("true position", "", f"4X {p}, 2X {p2}, {p / 4:.2f} cycles")
     row("enc_x4_decoder (4X)", f"count {fin['x4_count']}", f"{p}", f"error x{fin['n_x4_err']}")
+    row("enc_qei_wb (x4, bus)", f"COUNT {an['vel']['count']} (read over Wishbone)", f"{p}")
     row("enc_x2_xor (2X)", f"count {fin['x2_count']}", f"{p2}", f"error x{fin['n_x2_err']}")
     n1 = fin["x1_count"]
     row("enc_x1_hysteresis (1X)", f"count {n1} (4n - p = {4 * n1 - p:+d})",
@@ -671,9 +844,62 @@ def print_report(plan: Plan, res: dict, an: dict) -> None:
     row("narrowest state", f"{m.min_state_ns:.1f} ns = {an['min_clk']:.1f} clocks",
         f"limit {SAMPLING_LIMIT} / {LEVEL_LIMIT:.2f} clk (level)", f"glitch x{fin['n_glitch']}")
     print(line)
+    print_velocity(plan, an["vel"], line)
+    print(line)
     for name, ok, why in an["verdicts"]:
         print(f"  {'PASS' if ok else 'FAIL'}  {name:<20} {why}")
     print(line)
+
+
+def print_velocity(plan: Plan, vel: dict, line: str) -> None:
+    """The velocity table: one row per read (the hold's middle rows summed up in one line)."""
+    f_read = 1e3 / vel["read_us"]
+    print(f"velocity: enc_qei_wb read over Wishbone every {READ_TAU:g} cycles at the peak speed "
+          f"({vel['read_us']:.4g} us, {f_read:.4g} kHz; {vel['n_reads']} reads, the first only "
+          f"initialises); hedsmodel.velocity")
+    print(f"  M/T = SNAP_EDGE_DELTA / dSNAP_EDGE_TIME on A-rising edges, standstill rule, STALL_TIMEOUT "
+          f"{vel['stall_ticks']} ticks ({STALL_TAU:g} cycles); M = SNAP_DELTA / dSNAP_TIME")
+    print(line)
+    hdr = (f"{'t (ms)':>8}  {'segment':<9}{'true rpm':>10}{'M/T A-rise':>12}{'error %':>9}"
+           f"{'M rpm':>10}{'SNAP_EDGE_DELTA':>17}  check")
+    print(hdr)
+    print(line)
+
+    def show(r):
+        err = f"{r['err']:+.2f}" if r["err"] is not None else "-"
+        check = (("ok" if r["ok"] else "FAIL") + f" (<= {VEL_TOL_PCT:g} %)") if r["checked"] else ""
+        if not r["hw_ok"]:
+            check = (check + " " if check else "") + f"REGISTERS != MODEL EDGES ({r['mt_exact']:.1f})"
+        if r["stalled"]:
+            check = (check + " " if check else "") + "STALLED"
+        print(f"{r['t_ms']:8.3f}  {r['seg']:<9}{r['true'] + 0.0:10.1f}{r['mt'] + 0.0:12.1f}{err:>9}"
+              f"{r['m'] + 0.0:10.1f}{r['edge_delta']:17d}  {check}".rstrip())
+
+    rows = vel["rows"][1:]
+    hold = [r for r in rows if r["seg"] == "hold"]
+    middle = hold[2:-1] if len(hold) > 4 else []
+    mid_ids = {r["k"] for r in middle}
+    for r in rows:
+        if r["k"] in mid_ids:
+            if r is middle[0]:
+                e = [x["err"] for x in middle if x["err"] is not None]
+                bad = sum(1 for x in middle if (x["checked"] and not x["ok"]) or not x["hw_ok"])
+                print(f"{'':8}  {'hold':<9}... {len(middle)} more reads at {plan.opts.rpm:g} rpm: "
+                      f"M/T error {min(e):+.2f} .. {max(e):+.2f} %"
+                      + (f", {bad} FAILED" if bad else ", all ok"))
+            continue
+        show(r)
+    print(line)
+    print(f"  M/T at constant speed (both edges and the read in the hold or the back): "
+          f"{vel['checked']} reads, error rms {vel['rms']:.2f} %, max {vel['max']:.2f} % "
+          f"(tolerance {VEL_TOL_PCT:g} %: the encoder's own floor)")
+    print(f"  registers vs the same estimator on the model's exact edge times: max "
+          f"{vel['worst_hw']:.3g} % of the reading (allowed there {vel['hw_allow']:.2g} %, "
+          f"{VEL_HW_TICKS:g} ticks); SNAP_EDGE_DELTA = model count {vel['n_cnt'] - vel['n_cnt_bad']}/"
+          f"{vel['n_cnt']}; readings of 0 while turning (>= {VEL_SHOW_PCT:g} % of peak): "
+          f"{vel['zeros']}")
+    print(f"  error % is against the speed at the read: in ramps it is mostly the method's lag (a "
+          f"reading is the mean speed between two A-rising edges)")
 
 
 # ---------------------------------------------------------------------------------------------

@@ -3,9 +3,16 @@
 tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/demo.py compares
 the records with the model and prints the table.
 
+The bus peripheral enc_qei_wb is read as a host would, over Wishbone through tb/enc_qei/qei_tb.py's
+QeiBus (cocotbext-wishbone's WishboneMaster; register offsets and fields from the compiled
+rtl/enc_qei.rdl): once the waveform starts, STALL_TIMEOUT and SNAP_CTRL.EDGE are written; at each
+planned read time a snapshot is commanded (SNAP_CTRL.CMD) and SNAP_COUNT_LO, SNAP_TIME,
+SNAP_EDGE_TIME, SNAP_DELTA, SNAP_EDGE_DELTA and STATUS are read; after the profile, COUNT.
+
 Environment (set by scripts/demo.py):
   ENC_DEMO_PLAN      JSON: clk_ps, events [[t_ns, a, b]...], seg {name: [t0_ns, t1_ns]}, meas_rst_ns,
-                 hold_test_ns, hold_test_clocks, back_mid_ns
+                 hold_test_ns, hold_test_clocks, back_mid_ns, qei {reads_ns [...], edge (an
+                 SNAP_CTRL.EDGE member name), stall_ticks}
   ENC_DEMO_RESULT    JSON written at the end (see ``result`` below)
   ENC_DEMO_PROGRESS  a one-line file "<sim ns> <total ns> <segment>" rewritten as the run goes
 """
@@ -14,6 +21,7 @@ from __future__ import annotations
 
 import json
 import os
+import random
 
 import cocotb
 from cocotb.clock import Clock
@@ -22,6 +30,10 @@ from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import play
 from hedsmodel.waveform import Waveform
+from qei_tb import QeiBus, get_field, pack  # tb/enc_qei/ (on the runner's path via harness)
+
+QEI_READS = ("SNAP_COUNT_LO", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA",
+             "STATUS")
 
 
 def _int(sig) -> int:
@@ -119,6 +131,21 @@ async def _hold_test(dut, t_ps: float, clocks: int, out: dict) -> None:
     out.update(frozen=frozen, moved=moved, caught_up=caught, clocks=clocks)
 
 
+async def _qei_reads(bus: QeiBus, t0_ps: float, qei: dict, out: list) -> None:
+    """Set up enc_qei_wb, then at each planned time command a snapshot and read its registers
+    (``t_ack_ps``: when the SNAP_CTRL write was acknowledged, a clock or two after the latch)."""
+    edge = qei["edge"]
+    await bus.wr("STALL_TIMEOUT", int(qei["stall_ticks"]))
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE=edge))
+    for r_ns in qei["reads_ns"]:
+        await _until(t0_ps + r_ns * 1000.0)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        t_ack = get_sim_time("ps")
+        words = {n: await bus.rd(n) for n in QEI_READS}
+        words["stalled"] = get_field("STATUS", "STALLED", words["STATUS"])
+        out.append({"t_ack_ps": t_ack, **words})
+
+
 @cocotb.test()
 async def demo(dut):
     plan = json.loads(open(os.environ["ENC_DEMO_PLAN"]).read())
@@ -134,7 +161,12 @@ async def demo(dut):
     dut.hold.value = 0
     dut.a_in.value = events[0][1]
     dut.b_in.value = events[0][2]
-    for _ in range(4):
+    await FallingEdge(dut.clk)
+    # the Wishbone inputs from a clock edge on (set at time 0, Icarus left wb_ack_o at X)
+    for name in ("wb_cyc_i", "wb_stb_i", "wb_we_i", "wb_adr_i", "wb_dat_i", "wb_sel_i"):
+        getattr(dut, name).value = 0
+    bus = QeiBus(dut, random.Random(0))   # the bus master, idle, while rst is held
+    for _ in range(3):
         await FallingEdge(dut.clk)
     dut.rst.value = 0
     await Timer(clk_ps // 3, unit="ps")  # start the waveform off the clock grid
@@ -164,8 +196,13 @@ async def demo(dut):
                       ("dither_start", d0), ("dither_end", d1 + 20 * clk_ps / 1000)):
         cocotb.start_soon(snap(key, t_ns))
 
+    qei_reads: list = []
+    qei_task = cocotb.start_soon(_qei_reads(bus, t0, plan["qei"], qei_reads))
+
     await play(dut, wf, "a_in", "b_in")
     await _until(t0 + (total_ns + 1000.0) * 1000)
+    await qei_task
+    qei_count = await bus.count()
     for _ in range(50):
         await FallingEdge(dut.clk)
     await ReadOnly()
@@ -186,6 +223,7 @@ async def demo(dut):
                    "x2_net": de["x2_count"] - ds["x2_count"],
                    "x1_net": de["x1_count"] - ds["x1_count"]},
         "snaps": snaps,
+        "qei": {"reads": qei_reads, "count": qei_count},
     }
     with open(os.environ["ENC_DEMO_RESULT"], "w") as f:
         json.dump(result, f)

@@ -77,7 +77,21 @@ def test_short_demo_run(tmp_path):
                        capture_output=True, text=True, timeout=600, env=env, cwd=TOP)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "all circuits PASS" in r.stdout
-    assert r.stdout.count("  PASS  ") == 7
+    assert r.stdout.count("  PASS  ") == 8
+    # the velocity table: enc_qei_wb read over Wishbone, M/T against the model's true speed
+    out = r.stdout
+    assert "velocity: enc_qei_wb read over Wishbone" in out and "  PASS  enc_qei_wb" in out
+    vel = out[out.index("velocity: enc_qei_wb"):out.index("  PASS  enc_conditioner")]
+    rows = [ln.split() for ln in vel.splitlines() if ln[:8].strip().replace(".", "").isdigit()]
+    assert len(rows) >= 15, vel
+    segs = {row[1] for row in rows}
+    assert {"ramp", "hold", "reverse", "back", "stop", "dither"} <= segs, segs
+    hold = [row for row in rows if row[1] == "hold" and row[-1] == "%)"]   # checked: "ok (<= 1.2 %)"
+    assert hold and all(row[-4] == "ok" for row in hold), vel
+    for row in hold:   # at 20000 rpm, M/T A-rise within the tolerance of the true speed
+        true, mt = float(row[2]), float(row[3])
+        assert true == 20000.0 and abs(mt - true) <= demo.VEL_TOL_PCT / 100 * true, row
+    assert "FAIL" not in vel and "REGISTERS != MODEL" not in vel
     vcd = TOP / "sim" / "waves" / "demo_test.vcd"
     assert vcd.stat().st_size < 50e6
     found, _ = vcd_to_png.read_vcd(vcd, ["a_in", "b_in", "x4_count", "bcd_count"])

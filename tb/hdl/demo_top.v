@@ -10,13 +10,17 @@
 //          -> enc_phase_meter    Figure 11, averaging phase meter (reading and the two LEDs)
 //          -> enc_characterizer  Figure 3 encoding characteristics, per window of cycles
 //     -> enc_updown_buffer       Figure 17, BCD up/down buffer (its own conditioner, as built)
+//     -> enc_qei_wb              the bus peripheral (its own conditioner), read over Wishbone by
+//                                the bench: count, and the snapshot registers for velocity
 //
 // The x*_count accumulators (signed, 32 bits) only sum the decoders' pulses so the bench and the
 // waveform viewer can read the counts; they are not part of any circuit. The decoders are held in
 // reset until the conditioner shows the real input levels (its `valid`). `meas_rst` restarts the
 // phase meter and the characterizer (the bench presses it when the motor has reached constant
-// speed, so their first window holds constant-speed cycles only). Everything the waveform review
-// needs is a signal of this module, so the VCD can stop at this level (Verilator --trace-depth).
+// speed, so their first window holds constant-speed cycles only). enc_qei_wb runs at the reset
+// defaults (x4, free range, FILTER_LEN 3 at run time) with no index, probe or snap_in; the bench
+// drives its Wishbone port (wb_*). Everything the waveform review needs is a signal of this
+// module, so the VCD can stop at this level (Verilator --trace-depth).
 `default_nettype none
 
 module demo_top #(
@@ -32,6 +36,18 @@ module demo_top #(
     input  wire               a_in,        // channel A from the encoder (asynchronous)
     input  wire               b_in,        // channel B from the encoder (asynchronous)
     input  wire               hold,        // up/down buffer read inhibit
+    // enc_qei_wb: Wishbone B4 classic slave (driven by the bench's WishboneMaster)
+    input  wire        [7:0]  wb_adr_i,
+    input  wire        [31:0] wb_dat_i,
+    output wire        [31:0] wb_dat_o,
+    input  wire        [3:0]  wb_sel_i,
+    input  wire               wb_we_i,
+    input  wire               wb_stb_i,
+    input  wire               wb_cyc_i,
+    output wire               wb_ack_o,
+    output wire               wb_err_o,
+    output wire               qei_irq,     // enc_qei_wb irq (the demo enables no event)
+    output wire               qei_cmp,     // enc_qei_wb cmp_out (COMPARE at its reset value)
     // conditioner
     output wire               a,
     output wire               b,
@@ -174,6 +190,30 @@ module demo_top #(
       .state_min(ch_state_min),
       .pass     (ch_pass),
       .valid    (ch_valid)
+  );
+
+  enc_qei_wb #(
+      .COUNT_W(32),
+      .TS_W   (32)
+  ) u_qei (
+      .clk     (clk),
+      .rst     (rst),
+      .wb_adr_i(wb_adr_i),
+      .wb_dat_i(wb_dat_i),
+      .wb_dat_o(wb_dat_o),
+      .wb_sel_i(wb_sel_i),
+      .wb_we_i (wb_we_i),
+      .wb_stb_i(wb_stb_i),
+      .wb_cyc_i(wb_cyc_i),
+      .wb_ack_o(wb_ack_o),
+      .wb_err_o(wb_err_o),
+      .a_in    (a_in),
+      .b_in    (b_in),
+      .z_in    (1'b0),
+      .probe_in(1'b0),
+      .snap_in (1'b0),
+      .irq     (qei_irq),
+      .cmp_out (qei_cmp)
   );
 
   always @(posedge clk) begin
