@@ -898,8 +898,8 @@ def print_velocity(plan: Plan, vel: dict, line: str) -> None:
           f"{VEL_HW_TICKS:g} ticks); SNAP_EDGE_DELTA = model count {vel['n_cnt'] - vel['n_cnt_bad']}/"
           f"{vel['n_cnt']}; readings of 0 while turning (>= {VEL_SHOW_PCT:g} % of peak): "
           f"{vel['zeros']}")
-    print(f"  error % is against the speed at the read: in ramps it is mostly the method's lag (a "
-          f"reading is the mean speed between two A-rising edges)")
+    print("  error % is against the speed at the read: in ramps it is mostly the method's lag (a "
+          "reading is the mean speed between two A-rising edges)")
 
 
 # ---------------------------------------------------------------------------------------------
