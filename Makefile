@@ -26,7 +26,7 @@ SIM_OR_AUTO = $(if $(filter command line,$(origin SIM)),$(SIM),auto)
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -78,6 +78,13 @@ velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 u
 
 package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
 	@bash scripts/check_package.sh
+
+fusesoc: $(STAMP) ## run enc_ip.core's lint, sim and formal targets with FuseSoC itself (work in build/fusesoc)
+	@rm -rf build/fusesoc && mkdir -p build/fusesoc
+	@for t in lint sim formal; do echo "fusesoc: target $$t"; \
+	  (cd build/fusesoc && fusesoc --cores-root $(CURDIR) run --target=$$t heds5000:enc:enc_ip > $$t.log 2>&1) \
+	  || { echo "fusesoc: target $$t FAILED (build/fusesoc/$$t.log):"; tail -20 build/fusesoc/$$t.log; exit 1; }; done
+	@echo "fusesoc: lint, sim and formal targets of enc_ip.core passed"
 
 clean: ## remove simulation builds, waves and synthesis outputs (keeps .venv)
 	rm -rf sim/build sim/waves sim/results build .pytest_cache tb/__pycache__ tb/*/__pycache__ scripts/__pycache__
