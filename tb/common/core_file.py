@@ -61,9 +61,8 @@ def module_params(path: Path, guarded_only: bool = False) -> list[str]:
     """The parameters a Verilog file declares (``parameter integer NAME``). With
     ``guarded_only``, leave out those whose declaration says "(checked by <parent>)": internal
     submodules whose range the instantiating module guards."""
-    decls = re.findall(r"parameter\s+integer\s+(\w+)[^\n]*", Path(path).read_text())
-    lines = re.findall(r"parameter\s+integer\s+\w+[^\n]*", Path(path).read_text())
-    return [n for n, line in zip(decls, lines) if not (guarded_only and "checked by" in line)]
+    decls = re.findall(r"parameter\s+integer\s+(\w+)([^\n]*)", Path(path).read_text())
+    return [name for name, rest in decls if not (guarded_only and "checked by" in rest)]
 
 
 def ranged_params() -> list[str]:
