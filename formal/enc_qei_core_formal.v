@@ -43,8 +43,8 @@
 // Defines: PIPE_ONLY keeps only what does not depend on the count register (k-induction closes on
 // it from the ports alone); the count's induction needs the core's internal zero_q flag to agree
 // with count_q, an invariant the ports cannot show, so those properties run bounded (see the .sby).
-// NO_LATCHES drops the latch checks (COUNT_W 40 tasks); HI_STAGED assumes each COUNT_LO write
-// follows a COUNT_HI write (for a COUNT_W 40 induction: the staged word is invisible otherwise).
+// NO_LATCHES drops the latch checks (COUNT_W 34 task); HI_STAGED assumes each COUNT_LO write
+// follows a COUNT_HI write (for a COUNT_W 34 induction: the staged word is invisible otherwise).
 `default_nettype none
 
 module enc_qei_core_formal #(
@@ -186,9 +186,9 @@ module enc_qei_core_formal #(
 `endif
 
 `ifdef HI_STAGED
-  // Task prove_w40: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
+  // Task prove_w34: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
   // is internal state the ports do not show until a COUNT_LO write uses it; this keeps it known
-  // to the induction). bmc_w40 checks writes without this assumption, to a bounded depth.
+  // to the induction). bmc_w34 checks writes without this assumption, to a bounded depth.
   always @(*) begin
     if (f_past_valid && count_lo_wr) assume (f_hi_wr_q);
   end
@@ -421,7 +421,7 @@ module enc_qei_core_formal #(
 
 `ifndef NO_LATCHES
   // ---- latches: INDEX_LATCH (the count after the transition's step), probe (latency 1) ---------
-  // (left out of the COUNT_W 40 tasks by NO_LATCHES: there they slowed the solver from seconds to
+  // (left out of the COUNT_W 34 task by NO_LATCHES: there they slowed the solver from seconds to
   // more than ten minutes; the logic does not depend on the width)
   reg  f_pprev = 1'b0, f_pok = 1'b0, f_phit = 1'b0;
   reg  [COUNT_W-1:0] f_idx_latch = {COUNT_W{1'b0}}, f_probe_latch = {COUNT_W{1'b0}};
