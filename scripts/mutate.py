@@ -72,6 +72,38 @@ T_COND = "tb/enc_conditioner/test_enc_conditioner.py"
 T_RATE = "tb/count_rate/test_count_rate.py"
 T_BUF = "tb/enc_updown_buffer/test_enc_updown_buffer.py"
 T_PHASE = "tb/enc_phase_meter/test_enc_phase_meter.py"
+T_QEI_MUT = "tb/enc_qei/mutate_enc_qei.py::test_enc_qei_mutate"
+
+# The enc_qei modules run the regression's enc_qei cocotb tests (test_enc_qei.py and
+# test_enc_qei_gaps.py, the count-rate tests of qei_count_rate.py) through
+# tb/enc_qei/mutate_enc_qei.py, which builds test_enc_qei.py's two configurations and runs, in the
+# order given (ENC_QEI_MUT_TESTS, the third element of a corner), the listed cocotb tests, stopping
+# at the first failure (tb/enc_qei/qei_mutate_suite.py). Cheapest first; a module's list is every
+# test that exercises it.
+QEI_ALL = [f"test_enc_qei.{t}" for t in (
+    "register_walk", "reset_mid_motion", "events_and_irq", "unmapped_offsets", "byte_enables",
+    "coherent_64bit", "index_gate_same_position", "probe", "compare", "stall_and_recovery",
+    "prescaler_and_snap_in", "snapshot_deltas_across_wraps", "filter_lengths",
+    "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", "heds_unit_profile",
+    "period_capture", "func_walks")]
+QEI_RATE = ["qei_count_rate.never_silent", "qei_count_rate.exact_at_bound"]
+# what enc_qei instantiates, and an adapter (enc_qei and all that): -lib in the elaboration, read
+# in full (flattened) by the equivalence check of a survivor
+QEI_DEPS = ["rtl/enc_conditioner_rt.v", "rtl/enc_qei_core.v", "rtl/enc_x4_decoder.v",
+            "rtl/enc_x1_hysteresis.v", "rtl/enc_qei_timing.v", "rtl/enc_qei_regs.v"]
+QEI_DEPS_TOP = ["rtl/enc_qei.v"] + QEI_DEPS
+QEI_WB, QEI_AXIL = f"{T_QEI_MUT}[enc_qei_wb-c32-t32]", f"{T_QEI_MUT}[enc_qei_axil-c64-t16]"
+
+
+def qei_corners(wb: list[str] | None, axil: list[str] | None, params: bool = True) -> list:
+    """The corners of an enc_qei module: COUNT_W 32 / TS_W 32 (enc_qei_wb) and 64 / 16
+    (enc_qei_axil), each with its ordered cocotb test list (None: no corner there)."""
+    out = []
+    for cfg, (cw, tw), tests in ((QEI_WB, (32, 32), wb), (QEI_AXIL, (64, 16), axil)):
+        if tests is not None:
+            out.append(({"COUNT_W": cw, "TS_W": tw} if params else {}, [cfg], tests))
+    return out
+
 
 # module -> its source, the sources of the modules it instantiates, and per parameter corner the
 # pytest ids of the tests that run it there (fastest first: pytest -x stops at the first failure).
@@ -129,6 +161,42 @@ MODULES: dict[str, dict] = {
         "file": "rtl/enc_characterizer.v",
         "corners": [({"CNT_W": 12, "WINDOW_CYCLES": 32},
                      ["tb/enc_characterizer/test_enc_characterizer.py::test_enc_characterizer"])],
+    },
+    # enc_qei's parts (issue 12/13). enc_conditioner_rt has no parameter the configurations change
+    # (MAX_FILTER_LEN 16 in both): one corner, in the cheaper enc_qei_wb build. The bus adapters'
+    # logic does not depend on COUNT_W / TS_W (they only pass them on): each at its own
+    # configuration.
+    "enc_conditioner_rt": {
+        "file": "rtl/enc_conditioner_rt.v",
+        "corners": [({"MAX_FILTER_LEN": 16}, [QEI_WB], QEI_ALL + QEI_RATE)],
+    },
+    "enc_qei_core": {
+        "file": "rtl/enc_qei_core.v",
+        "deps": ["rtl/enc_x4_decoder.v", "rtl/enc_x1_hysteresis.v"],
+        "corners": qei_corners(QEI_ALL, QEI_ALL),
+    },
+    "enc_qei_timing": {
+        "file": "rtl/enc_qei_timing.v",
+        "corners": qei_corners(QEI_ALL, QEI_ALL),
+    },
+    "enc_qei_regs": {
+        "file": "rtl/enc_qei_regs.v",
+        "corners": qei_corners(QEI_ALL, QEI_ALL),
+    },
+    "enc_qei": {
+        "file": "rtl/enc_qei.v",
+        "deps": QEI_DEPS,
+        "corners": qei_corners(QEI_ALL, QEI_ALL),
+    },
+    "enc_qei_wb": {
+        "file": "rtl/enc_qei_wb.v",
+        "deps": QEI_DEPS_TOP,
+        "corners": qei_corners(QEI_ALL, None),
+    },
+    "enc_qei_axil": {
+        "file": "rtl/enc_qei_axil.v",
+        "deps": QEI_DEPS_TOP,
+        "corners": qei_corners(None, QEI_ALL),
     },
 }
 
@@ -200,6 +268,7 @@ class Corner:
     params: dict
     tests: list[str]
     index: int
+    cocotb_tests: list[str] = field(default_factory=list)  # ENC_QEI_MUT_TESTS: ordered subset
     baseline_s: float = 0.0
     error: str = ""
 
@@ -313,7 +382,10 @@ def chparams(c: Corner) -> str:
     defaults = module_defaults(TOP / snap(c.file))
     params = {k: defaults[k] for k in defaults}
     params.update({k: str(v) for k, v in c.params.items()})
-    return " ".join(f"-chparam {k} {v}" for k, v in params.items())
+    # Yosys cannot decode a negative -chparam value (enc_qei_regs's FIXED_FUNC = -1): a default
+    # that is not a plain non-negative number stays as the module declares it
+    return " ".join(f"-chparam {k} {v}" for k, v in params.items()
+                    if k in c.params or v.isdigit())
 
 
 def param_decls(c: Corner) -> str:
@@ -340,6 +412,15 @@ def add_params(verilog: str, c: Corner) -> str:
     if not m:
         raise RuntimeError(f"no module header for {c.module} in the written Verilog")
     return verilog[:m.end()] + param_decls(c) + verilog[m.end():]
+
+
+def generate_scopes(verilog: str) -> str:
+    """write_verilog flattens a generate block's instance into one escaped name (`\\g_timing.u_timing`
+    in enc_qei); the tests reach into it by its hierarchical path (dut.u_qei.g_timing.u_timing),
+    so put it back into a named block: `if (1) begin : g_timing ... u_timing (...); end`."""
+    pat = re.compile(r"^(  \w+(?: #\([^;]*?\n  \))?) \\(\w+)\.(\w+) +(\([^;]*?\n  \);\n)", re.M)
+    return pat.sub(lambda m: f"  if (1) begin : {m.group(2)}\n{m.group(1)} {m.group(3)} {m.group(4)}"
+                             f"  end\n", verilog)
 
 
 def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None = None) -> list[Mutant]:
@@ -373,7 +454,7 @@ def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None =
                            f"{proc.stdout}{proc.stderr}")
     for i in range(len(mutants) + 1):
         p = d / f"m{i:02d}.v"
-        p.write_text(add_params(p.read_text(), c))
+        p.write_text(generate_scopes(add_params(p.read_text(), c)))
     for m in mutants:
         m.path = d / f"m{m.number:02d}.v"
     return mutants
@@ -390,7 +471,8 @@ def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: fl
     override[c.file] = verilog
     env.update(ENC_RTL_OVERRIDE=",".join(f"{k}={v}" for k, v in override.items()),
                ENC_BUILD_ROOT=str(build), SIM="icarus",
-               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1")
+               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1",
+               ENC_QEI_MUT_TESTS=",".join(c.cocotb_tests))
     env.pop("WAVES", None)
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
            "-rf", *c.tests]
@@ -527,12 +609,14 @@ def main() -> int:
         ap.error("--mutation needs exactly one module in --only")
     if args.mutation:
         args.no_results = True
-    corners = [Corner(mod, params, tests, i)
-               for mod in modules for i, (params, tests) in enumerate(MODULES[mod]["corners"])]
+    corners = [Corner(mod, params, tests, i, list(rest[0]) if rest else [])
+               for mod in modules
+               for i, (params, tests, *rest) in enumerate(MODULES[mod]["corners"])]
     if args.list:
         for c in corners:
             n = args.n or MODULES[c.module].get("n", DEFAULT_N)
-            print(f"{c.module:18s} {c.label:32s} N={n:<3d} {' '.join(c.tests)}")
+            print(f"{c.module:18s} {c.label:32s} N={n:<3d} {' '.join(c.tests)}"
+                  + (f" [{','.join(c.cocotb_tests)}]" if c.cocotb_tests else ""))
         return 0
 
     t_start = time.monotonic()
