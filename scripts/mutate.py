@@ -40,6 +40,9 @@ Options:
   --rev REV        the RTL of a git revision (e.g. HEAD) instead of the working tree
   --mutation CMD   run given mutations instead (with one --only module): how the deterministic
                    tests were shown to kill the mutants of issue 14, see doc/mutation.md
+  --no-results     do not write doc/results/mutation.md
+  --report         run nothing: write the last run's table (build/mutate/seed<S>/results.json)
+                   again, with the reasons now in scripts/mutate_reviewed.txt
 """
 
 from __future__ import annotations
@@ -47,8 +50,10 @@ from __future__ import annotations
 import argparse
 import concurrent.futures
 import hashlib
+import json
 import os
 import re
+import resource
 import shlex
 import shutil
 import subprocess
@@ -80,12 +85,26 @@ T_QEI_MUT = "tb/enc_qei/mutate_enc_qei.py::test_enc_qei_mutate"
 # order given (ENC_QEI_MUT_TESTS, the third element of a corner), the listed cocotb tests, stopping
 # at the first failure (tb/enc_qei/qei_mutate_suite.py). Cheapest first; a module's list is every
 # test that exercises it.
-QEI_ALL = [f"test_enc_qei.{t}" for t in (
-    "register_walk", "reset_mid_motion", "events_and_irq", "unmapped_offsets", "byte_enables",
-    "coherent_64bit", "index_gate_same_position", "probe", "compare", "stall_and_recovery",
-    "prescaler_and_snap_in", "snapshot_deltas_across_wraps", "filter_lengths",
-    "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", "heds_unit_profile",
-    "period_capture", "func_walks")]
+def _qei(*names: str) -> list[str]:
+    """cocotb test ids: names from test_enc_qei.py, or module.name."""
+    return [n if "." in n else f"test_enc_qei.{n}" for n in names]
+
+
+G = "test_enc_qei_gaps."
+# Every enc_qei cocotb test of test_enc_qei.py and test_enc_qei_gaps.py (its expect_fail
+# reproducer left out: it cannot kill), cheapest and most killing first.
+QEI_ALL = _qei(
+    "register_walk", G + "register_patterns", "events_and_irq", "reset_mid_motion",
+    "byte_enables", "unmapped_offsets", "coherent_64bit", "index_gate_same_position", "probe",
+    "compare", G + "concurrent_reads_and_writes", "stall_and_recovery",
+    G + "snapshot_wide_values", G + "latches_wide", G + "step_soon_after_reset",
+    G + "reset_on_rejection_clock", "prescaler_and_snap_in", "snapshot_deltas_across_wraps",
+    "filter_lengths", G + "filter_len_clamp", G + "byte_enables_all", G + "swap_and_invert",
+    G + "period_large_n", G + "stall_timeout_exact", G + "probe_time_exact",
+    "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
+    "heds_unit_profile", G + "prescaler_long", "period_capture", G + "unit_timer_period",
+    "func_walks")
+# the count-rate tests (test_count_rate_qei.py builds enc_qei_wb at COUNT_W 32 / TS_W 32 too)
 QEI_RATE = ["qei_count_rate.never_silent", "qei_count_rate.exact_at_bound"]
 # what enc_qei instantiates, and an adapter (enc_qei and all that): -lib in the elaboration, read
 # in full (flattened) by the equivalence check of a survivor
@@ -173,7 +192,7 @@ MODULES: dict[str, dict] = {
     "enc_qei_core": {
         "file": "rtl/enc_qei_core.v",
         "deps": ["rtl/enc_x4_decoder.v", "rtl/enc_x1_hysteresis.v"],
-        "corners": qei_corners(QEI_ALL, QEI_ALL),
+        "corners": qei_corners(QEI_ALL + QEI_RATE, QEI_ALL),
     },
     "enc_qei_timing": {
         "file": "rtl/enc_qei_timing.v",
@@ -596,7 +615,12 @@ def main() -> int:
                     "mutate -list, on the one --only module at each of its corners; cell names "
                     "as in build/mutate/seed*/<module>_<corner>/orig.il")
     ap.add_argument("--no-results", action="store_true", help="do not write doc/results/mutation.md")
+    ap.add_argument("--report", action="store_true",
+                    help="run nothing: write the table of the last run (build/mutate/seed<S>/"
+                    "results.json) again, with the reasons now in scripts/mutate_reviewed.txt")
     args = ap.parse_args()
+    if args.report:
+        return report_again(args)
     if args.jobs < 1:
         ap.error("--jobs must be >= 1")
 
@@ -620,6 +644,7 @@ def main() -> int:
         return 0
 
     t_start = time.monotonic()
+    load_start = os.getloadavg()
     root = TOP / BUILD_REL / (f"seed{args.seed}" if not args.mutation else "given")
     if root.exists():
         shutil.rmtree(root)
@@ -697,10 +722,45 @@ def main() -> int:
         list(pool.map(one, todo))
 
     elapsed = time.monotonic() - t_start
-    return report(modules, corners, mutants, reviewed, args, elapsed)
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    run = {"elapsed": elapsed, "cpu": ru.ru_utime + ru.ru_stime, "jobs": args.jobs,
+           "load": [round(x, 1) for x in load_start + os.getloadavg()],
+           "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+    save_results(root, modules, corners, mutants, run)
+    return report(modules, corners, mutants, reviewed, args, elapsed, run)
 
 
-def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
+def save_results(root: Path, modules, corners, mutants, run: dict) -> None:
+    """The run's outcome (build/mutate/seed<S>/results.json), for `--report`."""
+    data = {"run": run, "modules": modules, "snapshot": str(SNAPSHOT),
+            "corners": [{"module": c.module, "params": c.params, "tests": c.tests, "index": c.index,
+                         "cocotb_tests": c.cocotb_tests, "baseline_s": c.baseline_s}
+                        for c in corners],
+            "mutants": [{"corner": corners.index(m.corner), "number": m.number,
+                         "command": m.command, "path": str(m.path), "result": m.result,
+                         "seconds": m.seconds, "failed_test": m.failed_test, "eq_note": m.eq_note,
+                         "opts": m.opts} for m in mutants]}
+    (root / "results.json").write_text(json.dumps(data, indent=1))
+
+
+def report_again(args) -> int:
+    global SNAPSHOT
+    path = TOP / BUILD_REL / f"seed{args.seed}" / "results.json"
+    if not path.exists():
+        sys.exit(f"mutate --report: no {path.relative_to(TOP)}; run make mutate first")
+    data = json.loads(path.read_text())
+    SNAPSHOT = Path(data["snapshot"])
+    corners = [Corner(c["module"], c["params"], c["tests"], c["index"], c["cocotb_tests"],
+                      c["baseline_s"]) for c in data["corners"]]
+    mutants = [Mutant(corners[m["corner"]], m["number"], m["command"], Path(m["path"]),
+                      m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
+               for m in data["mutants"]]
+    args.jobs = data["run"]["jobs"]
+    return report(data["modules"], corners, mutants, load_reviewed(), args,
+                  data["run"]["elapsed"], data["run"])
+
+
+def report(modules, corners, mutants, reviewed, args, elapsed, run: dict) -> int:
     rows = []
     for mod in modules:
         ms = [m for m in mutants if m.corner.module == mod]
@@ -732,7 +792,11 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
         print("  ".join(v.ljust(w) if j == 0 else v.rjust(w) for j, (v, w) in enumerate(zip(r, widths))))
         if i == 0:
             print("  ".join("-" * w for w in widths))
-    print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min")
+    load = run.get("load", [])
+    load_txt = (f"load average {load[0]} at the start, {load[3]} at the end (1-min)"
+                if len(load) == 6 else "")
+    print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall, "
+          f"{run.get('cpu', 0) / 60:.1f} CPU-min; {load_txt}")
 
     surv = [m for m in mutants if m.result == "survived"]
     unreviewed = [m for m in surv if m.mutant_id() not in reviewed]
@@ -744,7 +808,8 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
         md = ["# Mutation coverage", "",
               f"`make mutate` (scripts/mutate.py; how it works: doc/mutation.md). Seed {args.seed}, "
               f"{tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall time, "
-              f"{time.strftime('%Y-%m-%d', time.gmtime())}.", "",
+              f"{run.get('cpu', 0) / 60:.1f} CPU-minutes (user + system of the tools it ran), "
+              f"{load_txt}, {run.get('date', '')}.", "",
               "| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
         md += ["| " + " | ".join(r) + " |" for r in table[1:]]
         md += ["", "Score = killed / (generated - equivalent). A timeout counts as killed. "
@@ -753,8 +818,13 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
                "## Corners and tests", "", "| module | corner | tests | unmutated run (s) |",
                "|---|---|---|---:|"]
         for c in corners:
-            md.append(f"| {c.module} | {c.label} | {'<br>'.join(t.split('/')[-1] for t in c.tests)} "
-                      f"| {c.baseline_s:.1f} |")
+            tests = '<br>'.join(t.split('/')[-1] for t in c.tests)
+            if c.cocotb_tests:
+                tests += (f" ({len(c.cocotb_tests)} cocotb tests of test_enc_qei.py, "
+                          f"test_enc_qei_gaps.py" + (", qei_count_rate.py" if any(
+                              t.startswith("qei_count_rate.") for t in c.cocotb_tests) else "")
+                          + ", first failure ends the run)")
+            md.append(f"| {c.module} | {c.label} | {tests} | {c.baseline_s:.1f} |")
         md += ["", "## Survivors and equivalent mutants", ""]
         listed = [m for m in mutants if m.result in ("survived", "equivalent")]
         if listed:

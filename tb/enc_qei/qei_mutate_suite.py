@@ -10,6 +10,10 @@ check. Two things differ from a normal run, both for speed only:
   killing first). Unset or empty: every test of DEFAULT_MODULES in file order.
 - fail-fast: once a test has failed, the remaining ones are skipped (pytest.skip, so cocotb
   records them as skipped and the run still fails). A mutant is killed by its first failing test.
+  (A test marked expect_fail that fails as expected passes, and does not stop the run.)
+- a simulated-time limit per test (TIMEOUT_US, 1.4 x the longest test's time): a mutant that
+  never answers a bus cycle fails in seconds instead of running into scripts/mutate.py's
+  wall-clock timeout.
 
 Used only through tb/enc_qei/mutate_enc_qei.py (not collected by `make test`).
 """
@@ -25,6 +29,7 @@ import pytest
 from cocotb._decorators import Test, TestGenerator
 
 DEFAULT_MODULES = ("test_enc_qei", "test_enc_qei_gaps")
+TIMEOUT_US = 1000  # simulated time per test; the longest (period_capture at TS_W 16) needs ~700 us
 
 _failed: list[str] = []
 
@@ -39,12 +44,14 @@ def _fail_fast(t: Test) -> Test:
         try:
             await orig(dut, *args, **kwargs)
         except BaseException as e:  # an assertion, a timeout, or a cancel by a failing task
-            if not isinstance(e, pytest.skip.Exception):
+            if not isinstance(e, pytest.skip.Exception) and not t.expect_fail:
                 _failed.append(t.fullname)
             raise
 
     w = copy.copy(t)
     w.func = func
+    if w.timeout is None:  # a mutant that stops the bus must not hang the run (longest test: 0.7 ms)
+        w.timeout = (TIMEOUT_US, "us")
     return w
 
 
@@ -73,6 +80,11 @@ def _selected() -> list[Test]:
     return out
 
 
-# cocotb discovers the Test objects of this module's namespace, in insertion order
-for _i, _t in enumerate(_selected()):
-    globals()[f"_t{_i:02d}_{_t.name}"] = _fail_fast(_t)
+def _register() -> None:
+    """cocotb discovers the Test objects of this module's namespace, in insertion order (no loop
+    variable may stay behind at module level: it would be discovered too)."""
+    for i, t in enumerate(_selected()):
+        globals()[f"_t{i:02d}_{t.name}"] = _fail_fast(t)
+
+
+_register()
