@@ -95,6 +95,7 @@ G = "test_enc_qei_gaps."
 # reproducer left out: it cannot kill), cheapest and most killing first.
 QEI_ALL = _qei(
     "register_walk", G + "register_patterns", "events_and_irq", "reset_mid_motion",
+    G + "irq_low_in_reset", G + "wb_abandoned_cycle",
     "byte_enables", "unmapped_offsets", "coherent_64bit", "index_gate_same_position", "probe",
     "compare", G + "concurrent_reads_and_writes", "stall_and_recovery",
     G + "snapshot_wide_values", G + "latches_wide", G + "step_soon_after_reset",
@@ -104,6 +105,45 @@ QEI_ALL = _qei(
     "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
     "heds_unit_profile", G + "prescaler_long", "period_capture", G + "unit_timer_period",
     "func_walks")
+
+
+def qei_first(*names: str) -> list[str]:
+    """QEI_ALL with these tests first (a module's likeliest killers, cheapest first): every
+    mutant still runs every test until one fails, only the order differs."""
+    head = _qei(*(n if "." in n or n in _QEI_OWN else G + n for n in names))
+    missing = [h for h in head if h not in QEI_ALL]
+    if missing:
+        raise ValueError(f"not in QEI_ALL: {missing}")
+    return head + [t for t in QEI_ALL if t not in head]
+
+
+_QEI_OWN = {t.split(".")[1] for t in QEI_ALL if t.startswith("test_enc_qei.")}
+
+# per module: the tests that killed most of its mutants (seed 1) first
+QEI_ORDER = {
+    "enc_conditioner_rt": qei_first(
+        "register_walk", "reset_mid_motion", "events_and_irq", "byte_enables", "filter_lengths",
+        "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset"),
+    "enc_qei_core": qei_first(
+        "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
+        "coherent_64bit", "index_gate_same_position", "compare", "probe", "range_modes"),
+    "enc_qei_timing": qei_first(
+        "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "stall_timeout_exact",
+        "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",
+        "snapshot_coherence", "unit_timer_period", "period_capture"),
+    "enc_qei_regs": qei_first(
+        "register_walk", "register_patterns", "byte_enables", "byte_enables_all",
+        "reset_mid_motion", "events_and_irq", "unmapped_offsets", "irq_low_in_reset",
+        "probe_time_exact", "snapshot_wide_values", "latches_wide"),
+    "enc_qei": qei_first(
+        "register_walk", "register_patterns", "events_and_irq", "irq_low_in_reset",
+        "reset_mid_motion", "index_gate_same_position", "swap_and_invert",
+        "snapshot_deltas_across_wraps", "snapshot_wide_values"),
+    "bus": qei_first(
+        "register_walk", "register_patterns", "wb_abandoned_cycle", "concurrent_reads_and_writes",
+        "events_and_irq", "reset_mid_motion", "byte_enables", "unmapped_offsets"),
+}
+
 # the count-rate tests (test_count_rate_qei.py builds enc_qei_wb at COUNT_W 32 / TS_W 32 too)
 QEI_RATE = ["qei_count_rate.never_silent", "qei_count_rate.exact_at_bound"]
 # what enc_qei instantiates, and an adapter (enc_qei and all that): -lib in the elaboration, read
@@ -187,35 +227,35 @@ MODULES: dict[str, dict] = {
     # configuration.
     "enc_conditioner_rt": {
         "file": "rtl/enc_conditioner_rt.v",
-        "corners": [({"MAX_FILTER_LEN": 16}, [QEI_WB], QEI_ALL + QEI_RATE)],
+        "corners": [({"MAX_FILTER_LEN": 16}, [QEI_WB], QEI_ORDER["enc_conditioner_rt"] + QEI_RATE)],
     },
     "enc_qei_core": {
         "file": "rtl/enc_qei_core.v",
         "deps": ["rtl/enc_x4_decoder.v", "rtl/enc_x1_hysteresis.v"],
-        "corners": qei_corners(QEI_ALL + QEI_RATE, QEI_ALL),
+        "corners": qei_corners(QEI_ORDER["enc_qei_core"] + QEI_RATE, QEI_ORDER["enc_qei_core"]),
     },
     "enc_qei_timing": {
         "file": "rtl/enc_qei_timing.v",
-        "corners": qei_corners(QEI_ALL, QEI_ALL),
+        "corners": qei_corners(QEI_ORDER["enc_qei_timing"], QEI_ORDER["enc_qei_timing"]),
     },
     "enc_qei_regs": {
         "file": "rtl/enc_qei_regs.v",
-        "corners": qei_corners(QEI_ALL, QEI_ALL),
+        "corners": qei_corners(QEI_ORDER["enc_qei_regs"], QEI_ORDER["enc_qei_regs"]),
     },
     "enc_qei": {
         "file": "rtl/enc_qei.v",
         "deps": QEI_DEPS,
-        "corners": qei_corners(QEI_ALL, QEI_ALL),
+        "corners": qei_corners(QEI_ORDER["enc_qei"], QEI_ORDER["enc_qei"]),
     },
     "enc_qei_wb": {
         "file": "rtl/enc_qei_wb.v",
         "deps": QEI_DEPS_TOP,
-        "corners": qei_corners(QEI_ALL, None),
+        "corners": qei_corners(QEI_ORDER["bus"], None),
     },
     "enc_qei_axil": {
         "file": "rtl/enc_qei_axil.v",
         "deps": QEI_DEPS_TOP,
-        "corners": qei_corners(None, QEI_ALL),
+        "corners": qei_corners(None, QEI_ORDER["bus"]),
     },
 }
 
