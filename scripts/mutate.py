@@ -126,7 +126,8 @@ QEI_ORDER = {
         "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset"),
     "enc_qei_core": qei_first(
         "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
-        "coherent_64bit", "index_gate_same_position", "compare", "probe", "range_modes"),
+        "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",
+        "range_modes", "index", "ceiling_wide"),
     "enc_qei_timing": qei_first(
         "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "stall_timeout_exact",
         "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",
@@ -658,6 +659,9 @@ def main() -> int:
     ap.add_argument("--report", action="store_true",
                     help="run nothing: write the table of the last run (build/mutate/seed<S>/"
                     "results.json) again, with the reasons now in scripts/mutate_reviewed.txt")
+    ap.add_argument("--results", default="", metavar="JSON[,JSON]",
+                    help="with --report: these results.json files (runs of different modules, "
+                    "e.g. copies kept from earlier runs), as one table")
     args = ap.parse_args()
     if args.report:
         return report_again(args)
@@ -784,20 +788,35 @@ def save_results(root: Path, modules, corners, mutants, run: dict) -> None:
 
 
 def report_again(args) -> int:
+    """The table of earlier runs, from their results.json; several runs (of different modules)
+    are summed into one table: wall and CPU time added, each run's load kept."""
     global SNAPSHOT
-    path = TOP / BUILD_REL / f"seed{args.seed}" / "results.json"
-    if not path.exists():
-        sys.exit(f"mutate --report: no {path.relative_to(TOP)}; run make mutate first")
-    data = json.loads(path.read_text())
-    SNAPSHOT = Path(data["snapshot"])
-    corners = [Corner(c["module"], c["params"], c["tests"], c["index"], c["cocotb_tests"],
-                      c["baseline_s"]) for c in data["corners"]]
-    mutants = [Mutant(corners[m["corner"]], m["number"], m["command"], Path(m["path"]),
-                      m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
-               for m in data["mutants"]]
-    args.jobs = data["run"]["jobs"]
-    return report(data["modules"], corners, mutants, load_reviewed(), args,
-                  data["run"]["elapsed"], data["run"])
+    paths = ([Path(p) for p in args.results.split(",") if p] if args.results
+             else [TOP / BUILD_REL / f"seed{args.seed}" / "results.json"])
+    modules, corners, mutants, runs = [], [], [], []
+    for path in paths:
+        path = path if path.is_absolute() else TOP / path
+        if not path.exists():
+            sys.exit(f"mutate --report: no {path}; run make mutate first")
+        data = json.loads(path.read_text())
+        SNAPSHOT = Path(data["snapshot"])  # the same for every run of one seed
+        cs = [Corner(c["module"], c["params"], c["tests"], c["index"], c["cocotb_tests"],
+                     c["baseline_s"]) for c in data["corners"]]
+        mutants += [Mutant(cs[m["corner"]], m["number"], m["command"], Path(m["path"]),
+                           m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
+                    for m in data["mutants"]]
+        modules += [m for m in data["modules"] if m not in modules]
+        corners += cs
+        runs.append(data["run"])
+    modules = [m for m in MODULES if m in modules] + [m for m in modules if m not in MODULES]
+    corners.sort(key=lambda c: (modules.index(c.module), c.index))
+    run = dict(runs[-1])
+    run["elapsed"] = sum(r["elapsed"] for r in runs)
+    run["cpu"] = sum(r.get("cpu", 0) for r in runs)
+    if len(runs) > 1:
+        run["parts"] = runs
+    args.jobs = run["jobs"]
+    return report(modules, corners, mutants, load_reviewed(), args, run["elapsed"], run)
 
 
 def report(modules, corners, mutants, reviewed, args, elapsed, run: dict) -> int:
@@ -832,9 +851,16 @@ def report(modules, corners, mutants, reviewed, args, elapsed, run: dict) -> int
         print("  ".join(v.ljust(w) if j == 0 else v.rjust(w) for j, (v, w) in enumerate(zip(r, widths))))
         if i == 0:
             print("  ".join("-" * w for w in widths))
-    load = run.get("load", [])
-    load_txt = (f"load average {load[0]} at the start, {load[3]} at the end (1-min)"
-                if len(load) == 6 else "")
+    def load_of(r: dict) -> str:
+        ld = r.get("load", [])
+        return (f"load average {ld[0]} at the start, {ld[3]} at the end (1-min)"
+                if len(ld) == 6 else "")
+
+    load_txt = load_of(run)
+    if run.get("parts"):
+        load_txt = f"in {len(run['parts'])} runs: " + "; ".join(
+            f"{r['elapsed'] / 60:.1f} min wall, {r.get('cpu', 0) / 60:.1f} CPU-min, {load_of(r)}, "
+            f"{r.get('date', '')}" for r in run["parts"])
     print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall, "
           f"{run.get('cpu', 0) / 60:.1f} CPU-min; {load_txt}")
 

@@ -535,7 +535,7 @@ async def irq_low_in_reset(dut):
     bus = env.bus
     await bus.wr("IRQ_EN", 0xFFF)
     await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))  # SNAP_READY pending
-    await env.settle(4)
+    await env.settle(20)
     assert dut.irq.value == 1
     await FallingEdge(dut.clk)
     dut.rst.value = 1
