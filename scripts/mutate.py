@@ -43,6 +43,9 @@ Options:
   --no-results     do not write doc/results/mutation.md
   --report         run nothing: write the last run's table (build/mutate/seed<S>/results.json)
                    again, with the reasons now in scripts/mutate_reviewed.txt
+  --results A,B    with --report: the results.json of several runs (of different modules) as
+                   one table
+  --work NAME      work in build/mutate/NAME instead of build/mutate/seed<S>
 """
 
 from __future__ import annotations
@@ -659,6 +662,9 @@ def main() -> int:
     ap.add_argument("--report", action="store_true",
                     help="run nothing: write the table of the last run (build/mutate/seed<S>/"
                     "results.json) again, with the reasons now in scripts/mutate_reviewed.txt")
+    ap.add_argument("--work", default="", metavar="NAME",
+                    help="work directory build/mutate/NAME (default seed<S>): two runs of "
+                    "different modules at once need two")
     ap.add_argument("--results", default="", metavar="JSON[,JSON]",
                     help="with --report: these results.json files (runs of different modules, "
                     "e.g. copies kept from earlier runs), as one table")
@@ -689,7 +695,7 @@ def main() -> int:
 
     t_start = time.monotonic()
     load_start = os.getloadavg()
-    root = TOP / BUILD_REL / (f"seed{args.seed}" if not args.mutation else "given")
+    root = TOP / BUILD_REL / (args.work or (f"seed{args.seed}" if not args.mutation else "given"))
     if root.exists():
         shutil.rmtree(root)
     root.mkdir(parents=True)
