@@ -382,7 +382,7 @@ class Mutant:
 
     def describe(self) -> str:
         o = self.opts
-        cell = o.get("cell", "").replace(f"{SNAPSHOT}/", "")
+        cell = unsnap(o.get("cell", ""))
         what = f"{o.get('mode')} {cell}.{o.get('port')}[{o.get('portbit')}]"
         if "ctrlbit" in o:
             what += f" ctrl[{o['ctrlbit']}]"
@@ -390,9 +390,14 @@ class Mutant:
             what += f" ({o['wire']}[{o.get('wirebit')}])"
         srcs = sorted(o.get("src", []), key=lambda x: len(src_text(x)))  # innermost first
         if srcs:
-            loc = srcs[0].split("-")[0].rsplit(".", 1)[0].replace(f"{SNAPSHOT}/", "")
+            loc = unsnap(srcs[0].split("-")[0].rsplit(".", 1)[0])
             what += f" at {loc} `{src_text(srcs[0])[:60]}`"
         return what
+
+
+def unsnap(text: str) -> str:
+    """A path into any run's RTL copy (build/mutate/<work>/src/rtl/x.v) as rtl/x.v."""
+    return re.sub(r"build/mutate/[^/\s]+/src/", "", text)
 
 
 def parse_mutate(command: str) -> dict:
