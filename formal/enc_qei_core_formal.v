@@ -20,6 +20,11 @@
 //                       the index hit of sample s (ev_index); the range applies the step: the
 //                       count, STOPPED, applied_up/dn, overflow/underflow are those of this clock
 //   clock t + 3         count shows it; ev_cmp / cmp_out one clock later if it equals COMPARE
+// CEILING: the range uses the ceiling input as of two clocks earlier (a CEILING write acts two
+// clocks after it; the core keeps a pipeline of it so that count >= CEILING is a flag register).
+// COUNT_LO writes load the count one clock after their strobe (the value: the written low word
+// and the staged high word of the strobe's clock); an index preset loads PRESET of the clock
+// before (both registered in the core with their comparisons, for Fmax).
 // x1_hyst (Figure 14) is proven in formal/enc_x1_hysteresis.sby; here its steps are taken from the
 // core's step ports (only "never both" and EN gating are checked), the range model still applies
 // them independently.
@@ -315,7 +320,13 @@ module enc_qei_core_formal #(
   reg                f_cmp = 1'b0;
 
   wire f_at_zero = (f_count == ZERO);
-  wire f_at_ceil = (f_count >= ceiling);
+  // CEILING acts two clocks after it is set (the core's ceiling pipeline, for Fmax): f_ceil
+  reg  [COUNT_W-1:0] f_ceil1 = {COUNT_W{1'b0}}, f_ceil = {COUNT_W{1'b0}};
+  always @(posedge clk) begin
+    f_ceil1 <= ceiling;
+    f_ceil  <= f_ceil1;
+  end
+  wire f_at_ceil = (f_count >= f_ceil);
   reg  [COUNT_W-1:0] f_stepped;
   reg  f_ovf, f_unf, f_took, f_stop_d;
 
@@ -354,7 +365,7 @@ module enc_qei_core_formal #(
           f_took = 1'b1;
         end
         R_MODULO: begin
-          f_stepped = f_at_zero ? ceiling : f_count - ONE;
+          f_stepped = f_at_zero ? f_ceil : f_count - ONE;
           f_unf = f_at_zero;
           f_took = 1'b1;
         end
@@ -368,15 +379,24 @@ module enc_qei_core_formal #(
         end
       endcase
     end
-    if (count_lo_wr) f_stop_d = 1'b0;  // a COUNT write releases non_recycle
+    if (f_lw_q) f_stop_d = 1'b0;  // a COUNT write releases non_recycle
   end
 
   wire               f_armed = idx_arm & (idx_action != 2'd0);
   wire               f_preset = f_ihit & f_armed & (idx_action == I_PRESET);
-  wire               f_load = count_lo_wr | f_preset;
-  wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};
+  wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};  // the value a COUNT_LO write loads
   wire [COUNT_W-1:0] f_wr = f_wr64[COUNT_W-1:0];
-  wire [COUNT_W-1:0] f_next = count_lo_wr ? f_wr : f_preset ? preset : f_stepped;
+  // a COUNT_LO write loads the count one clock after its strobe (f_lw_q, f_wr_q), an index preset
+  // loads PRESET as it was one clock earlier (f_pre_q)
+  reg                f_lw_q = 1'b0;
+  reg  [COUNT_W-1:0] f_wr_q = {COUNT_W{1'b0}}, f_pre_q = {COUNT_W{1'b0}};
+  always @(posedge clk) begin
+    f_lw_q  <= ~rst & count_lo_wr;
+    f_wr_q  <= f_wr;
+    f_pre_q <= preset;
+  end
+  wire               f_load = f_lw_q | f_preset;
+  wire [COUNT_W-1:0] f_next = f_lw_q ? f_wr_q : f_preset ? f_pre_q : f_stepped;
   wire [63:0]        f_count64 = {{(64 - COUNT_W) {1'b0}}, f_count};
 
   always @(posedge clk) begin
@@ -478,30 +498,30 @@ module enc_qei_core_formal #(
     if (f_past_valid && !$past(rst)) begin
       // an applied step moves the count by exactly one, in the range
       if ($past(applied_up))
-        assert (count == (($past(range) == R_MODULO && $past(count) >= $past(ceiling)) ? ZERO :
+        assert (count == (($past(range) == R_MODULO && $past(count) >= $past(f_ceil)) ? ZERO :
                           $past(count) + ONE));
       if ($past(applied_dn))
-        assert (count == (($past(range) == R_MODULO && $past(count) == ZERO) ? $past(ceiling) :
+        assert (count == (($past(range) == R_MODULO && $past(count) == ZERO) ? $past(f_ceil) :
                           $past(count) - ONE));
       assert (!$past(applied_up && applied_dn));
       // the count changes only by a step, a COUNT_LO write or an index preset
-      if (!$past(applied_up || applied_dn || count_lo_wr || f_preset)) assert (count == $past(count));
-      if ($past(count_lo_wr)) assert (count == $past(f_wr));
+      if (!$past(applied_up || applied_dn || f_lw_q || f_preset)) assert (count == $past(count));
+      if ($past(f_lw_q)) assert (count == $past(f_wr_q));
       // a bounded range is never left by counting
-      if ($past(range) != R_FREE && $past(count) <= $past(ceiling) && !$past(f_load))
-        assert (count <= $past(ceiling));
+      if ($past(range) != R_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
+        assert (count <= $past(f_ceil));
       // limit / non_recycle: never past the bounds, the stop raises the event and is no step
       if ($past(range) == R_LIMIT || $past(range) == R_NON_RECYCLE) begin
-        if ($past(step_up) && $past(count) >= $past(ceiling))
+        if ($past(step_up) && $past(count) >= $past(f_ceil))
           assert (!$past(applied_up) && $past(ev_overflow) == ($past(range) == R_LIMIT || !$past(stopped)));
         if ($past(step_dn) && !$past(step_up) && $past(count) == ZERO)
           assert (!$past(applied_dn) && $past(ev_underflow) == ($past(range) == R_LIMIT || !$past(stopped)));
       end
       // non_recycle: stopped stays stopped (and the count still) until a COUNT_LO write
-      if ($past(stopped) && !$past(count_lo_wr)) assert (stopped);
+      if ($past(stopped) && !$past(f_lw_q)) assert (stopped);
       if ($past(stopped) && $past(range) == R_NON_RECYCLE && !$past(f_load))
         assert (count == $past(count) && !$past(applied_up || applied_dn));
-      if ($past(count_lo_wr)) assert (!stopped);
+      if ($past(f_lw_q)) assert (!stopped);
     end
   end
 
@@ -557,17 +577,17 @@ module enc_qei_core_formal #(
       cover (range == R_FREE && ev_overflow && applied_up);
       cover (range == R_FREE && ev_underflow && applied_dn);
       cover (range == R_MODULO && ev_overflow && applied_up && count != ZERO);
-      cover (range == R_MODULO && ev_underflow && applied_dn && ceiling != ALL1);
-      cover (range == R_LIMIT && ev_overflow && step_up && count == ceiling && ceiling != ALL1);
+      cover (range == R_MODULO && ev_underflow && applied_dn && f_ceil != ALL1);
+      cover (range == R_LIMIT && ev_overflow && step_up && count == f_ceil && f_ceil != ALL1);
       cover (range == R_LIMIT && ev_underflow && step_dn);
-      cover (range == R_NON_RECYCLE && ev_overflow && !stopped && ceiling != ALL1);
+      cover (range == R_NON_RECYCLE && ev_overflow && !stopped && f_ceil != ALL1);
       cover (range == R_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
-      cover ($past(stopped) && count_lo_wr && !rst);          // released by a COUNT_LO write
+      cover ($past(stopped) && f_lw_q && !rst);               // released by a COUNT_LO write
       cover (ev_qerr && func == F_X4);
       cover (ev_dir_change && step_dn);
       cover (ev_dir_change && step_up);
       cover (ev_cmp && $past(applied_up));
-      cover (ev_cmp && $past(count_lo_wr, 2));
+      cover (ev_cmp && $past(f_lw_q, 2));
       cover (ev_cmp && $past(f_preset, 2));
       cover (f_preset && (step_up | step_dn));                 // a preset wins over the step
       cover (func == F_X2A && applied_dn);

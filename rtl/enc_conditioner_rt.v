@@ -131,9 +131,10 @@ module enc_conditioner_rt #(
     end
   end
 
-  // valid = settle_q[last5 + 1], taken as a register of settle_q[last5] (the same value, one
-  // stage on: the tap's multiplexer is not in front of the decoders' reset; Fmax). A loop, so the
-  // index needs no width of its own.
+  // valid = settle_q[last5 + 2] (1 from the clock after edge filter_len + 2 after rst, the clock
+  // the filter first shows the inputs), taken as a register of settle_q[last5 + 1] (the same
+  // value, one stage on: the tap's multiplexer is not in front of the decoders' reset; Fmax). A
+  // loop, so the index needs no width of its own.
   reg        tap_d;
   reg        valid_d;
   integer    i;
@@ -141,7 +142,7 @@ module enc_conditioner_rt #(
   always @(*) begin
     tap_d = 1'b0;
     for (i = 0; i < SETTLE - 1; i = i + 1) begin
-      if (last5 == i[4:0]) tap_d = settle_q[i];
+      if (last5 == i[4:0]) tap_d = settle_q[i + 1];
     end
   end
 

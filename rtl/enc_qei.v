@@ -12,7 +12,7 @@
 // Z and probe_in go through their own synchronizer and filter of the same length as A and B, so
 // the index lines up with the channels clock for clock. irq is registered: high from the clock
 // after an enabled event is pending until the clock after it is cleared or disabled.
-// Request/response port: see enc_qei_regs (response in the clock after the request).
+// Request/response port: see enc_qei_regs (response two clocks after the request).
 //
 // Build options (defaults: the contract's full peripheral):
 //   PROFILE = 1     issue 12's peripheral: the timing unit (enc_qei_timing) is left out:
@@ -38,7 +38,7 @@ module enc_qei #(
     input  wire [7:0]  req_addr,    // byte address (bits 1:0 ignored)
     input  wire [31:0] req_wdata,
     input  wire [3:0]  req_wstrb,   // byte enables
-    output wire        resp_valid,  // the clock after req_valid
+    output wire        resp_valid,  // two clocks after req_valid (one request at a time)
     output wire [31:0] resp_rdata,
     output wire        resp_err,    // unmapped offset
     input  wire        a_in,        // encoder channel A, asynchronous

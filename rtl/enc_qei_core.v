@@ -16,6 +16,10 @@
 // written). Every decoder output has latency 1 from its sample and the count step one more
 // register; the index edge detector is delayed the same, so an index acts in the clock of the
 // transition it sees.
+// For Fmax, the comparisons with CEILING and the zero tests of the loads are flag registers:
+// CEILING acts two clocks after it changes, a COUNT_LO write loads the count one clock after
+// its strobe (with the COUNT_HI word staged as of the strobe), and an index preset loads PRESET
+// as it was one clock earlier. A bus access takes longer than these delays: software cannot tell.
 `default_nettype none
 
 module enc_qei_core #(
@@ -251,24 +255,49 @@ module enc_qei_core #(
   wire at_zero = zero_q;
   wire at_max  = (count_q == {COUNT_W{1'b1}});
 
-  // at_ceil = (count_q >= ceiling) from 16-bit slices compared side by side (short carry chains),
-  // the slowest signal here: the next count below is arranged so that it selects last (Fmax)
+  // a >= b for COUNT_W-bit values, from 16-bit slices compared side by side (short carry chains;
+  // the slices' > and >= are carry chains too, no equality trees)
   localparam integer NSL = (COUNT_W + 15) / 16;
-  wire [63:0] cq64 = zext64(count_q);
-  wire [63:0] ce64 = zext64(ceiling);
-  reg         at_ceil;
-  integer     k;
 
-  always @(*) begin
-    at_ceil = 1'b1;
-    for (k = 0; k < NSL; k = k + 1) begin
-      at_ceil = (cq64[16*k +: 16] > ce64[16*k +: 16]) |
-                ((cq64[16*k +: 16] == ce64[16*k +: 16]) & at_ceil);
+  function ge_w;
+    input [COUNT_W-1:0] a;
+    input [COUNT_W-1:0] b;
+    reg   [63:0] a64, b64;
+    integer      k;
+    begin
+      a64  = zext64(a);
+      b64  = zext64(b);
+      ge_w = (a64[15:0] >= b64[15:0]);
+      for (k = 1; k < NSL; k = k + 1) begin  // (slice equal: both >= and not >)
+        ge_w = (a64[16*k +: 16] > b64[16*k +: 16]) | ((a64[16*k +: 16] >= b64[16*k +: 16]) & ge_w);
+      end
     end
+  endfunction
+
+  // ---- CEILING pipeline (Fmax) ----------------------------------------------------------------------
+  // The count uses CEILING as it was two clocks earlier (ceil_q), so that at_ceil = (count >=
+  // CEILING) can be a flag register (at_ceil_q), set like zero_q from the next count's candidates,
+  // each compared with the next clock's ceiling (ceil_nx_q) by a comparator between registers.
+  // Not reset: a pure delay of the CEILING register.
+  reg [COUNT_W-1:0] ceil_nx_q;       // CEILING one clock ago: the ceiling of the next clock
+  reg [COUNT_W-1:0] ceil_nx_m1_q;    // ... minus one
+  reg               ceil_nx_zero_q;  // ... is 0
+  reg [COUNT_W-1:0] ceil_q;          // CEILING two clocks ago: the ceiling the count uses now
+  reg               ceil_zero_q;     // ... is 0
+  reg               ceil_wrap_ge_q;  // ceil_q >= ceil_nx_q (a modulo wrap down to ceil_q)
+
+  always @(posedge clk) begin
+    ceil_nx_q      <= ceiling;
+    ceil_nx_m1_q   <= ceiling - {{(COUNT_W-1){1'b0}}, 1'b1};
+    ceil_nx_zero_q <= (ceiling == {COUNT_W{1'b0}});
+    ceil_q         <= ceil_nx_q;
+    ceil_zero_q    <= ceil_nx_zero_q;
+    ceil_wrap_ge_q <= ge_w(ceil_nx_q, ceiling);
   end
 
-  wire [COUNT_W-1:0] count_inc = count_q + {{(COUNT_W-1){1'b0}}, 1'b1};
-  wire [COUNT_W-1:0] count_dec = count_q - {{(COUNT_W-1){1'b0}}, 1'b1};
+  reg  at_ceil_q;  // count_q >= ceil_q
+  wire at_ceil = at_ceil_q;
+
 
   reg               ovf, unf, took;
 
@@ -319,7 +348,7 @@ module enc_qei_core #(
         end
       end
     endcase
-    if (count_lo_wr) begin
+    if (wr_q) begin
       stopped_d = 1'b0;
     end
   end
@@ -352,67 +381,101 @@ module enc_qei_core #(
   // verilator lint_off UNUSEDSIGNAL
   wire [63:0] wr_value = {hi_stage_q, count_lo_wdata};  // (the bits above COUNT_W are dropped)
   // verilator lint_on UNUSEDSIGNAL
-  wire        load     = count_lo_wr | idx_preset;
 
-  // The same next count as "load value, else stepped", arranged as
-  //   count_d = (up_ceil & at_ceil) ? (modulo ? 0 : count_q) : count_other
-  // where count_other is the next count when the count is below CEILING (all early signals).
-  wire        bounded = (range != R_FREE) & ~((range == R_NON_RECYCLE) & stopped_q);
-  wire        up_ceil = ~load & step_up & bounded;  // an up step that CEILING may stop or wrap
-  wire [COUNT_W-1:0] ceil_val = (range == R_MODULO) ? {COUNT_W{1'b0}} : count_q;  // up at CEILING
-  reg  [COUNT_W-1:0] step_other;   // the count after this clock's step when below CEILING
-  reg  [COUNT_W-1:0] count_other;  // ... and after the loads
-  reg  [COUNT_W-1:0] stepped;      // the count after this clock's step (before loads)
+  // COUNT_LO writes and PRESET, registered (Fmax): a COUNT_LO write loads the count one clock
+  // later, and an index preset loads PRESET as it was one clock earlier, so that their
+  // comparisons with the ceiling and their zero tests are flag registers too.
+  reg               wr_q;        // a COUNT_LO write to apply this clock
+  reg [COUNT_W-1:0] wr_val_q;    // ... its value
+  reg               wr_ge_q;     // ... >= ceil_nx_q
+  reg               wr_zero_q;   // ... == 0
+  reg [COUNT_W-1:0] preset_q;    // PRESET one clock ago
+  reg               pre_ge_q;    // ... >= ceil_nx_q
+  reg               pre_zero_q;  // ... == 0
 
-  always @(*) begin
-    if ((range == R_NON_RECYCLE) & stopped_q) begin
-      step_other = count_q;
-    end else if (step_up) begin
-      step_other = count_inc;
-    end else if (step_dn) begin
-      if (at_zero & (range != R_FREE)) begin
-        step_other = (range == R_MODULO) ? ceiling : count_q;
-      end else begin
-        step_other = count_dec;
-      end
+  always @(posedge clk) begin
+    if (rst) begin
+      wr_q <= 1'b0;
     end else begin
-      step_other = count_q;
+      wr_q <= count_lo_wr;
     end
-    if (count_lo_wr) begin
-      count_other = wr_value[COUNT_W-1:0];
-    end else if (idx_preset) begin
-      count_other = preset;
-    end else begin
-      count_other = step_other;
-    end
-    count_d = (up_ceil & at_ceil) ? ceil_val : count_other;
-    stepped = (step_up & bounded & at_ceil) ? ceil_val : step_other;
   end
 
-  // zero_d = (count_d == 0), from the same choice over the candidates' zero tests
-  reg zero_other, zero_d;
+  always @(posedge clk) begin
+    wr_val_q   <= wr_value[COUNT_W-1:0];
+    wr_ge_q    <= ge_w(wr_value[COUNT_W-1:0], ceiling);
+    wr_zero_q  <= (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}});
+    preset_q   <= preset;
+    pre_ge_q   <= ge_w(preset, ceiling);
+    pre_zero_q <= (preset == {COUNT_W{1'b0}});
+  end
+
+  wire        load     = wr_q | idx_preset;
+
+  // ---- next count, zero_q and at_ceil_q ---------------------------------------------------------------
+  // The cases of a clock without a load (an index latch stores the count of this case):
+  wire bounded = (range != R_FREE) & ~((range == R_NON_RECYCLE) & stopped_q);
+  wire modulo  = (range == R_MODULO);
+  wire c_stop  = (range == R_NON_RECYCLE) & stopped_q;           // non_recycle stopped: held
+  wire c_ceil  = step_up & bounded & at_ceil;                    // up at CEILING: wrap or hold
+  wire c_up    = ~c_stop & step_up & ~c_ceil;
+  wire c_dn    = ~c_stop & ~step_up & step_dn;
+  wire c_dwrap = c_dn & at_zero & (range != R_FREE);             // down at 0: wrap or hold
+  wire k_inc   = c_up;                                           // count_q + 1
+  wire k_dec   = c_dn & ~c_dwrap;                                // count_q - 1
+  wire k_zero  = c_ceil & modulo;                                // 0
+  wire k_ceil  = c_dwrap & modulo;                               // the ceiling
+  wire k_hold  = ~k_inc & ~k_dec & ~k_zero & ~k_ceil;            // count_q
+  // ... and with the loads (COUNT write first, then an index preset): one-hot selects. (keep:
+  // Yosys leaves them as nets, so that the late signals below are not folded into their logic.)
+  wire s_wr    = wr_q;
+  wire s_pre   = ~wr_q & idx_preset;
+  (* keep *) wire s_inc;
+  assign s_inc  = ~load & k_inc;
+  (* keep *) wire s_dec;
+  assign s_dec  = ~load & k_dec;
+  (* keep *) wire s_zero;
+  assign s_zero = ~load & k_zero;
+  (* keep *) wire s_ceil;
+  assign s_ceil = ~load & k_ceil;
+  (* keep *) wire s_hold;
+  assign s_hold = ~load & k_hold;
+
+  // Every value is an AND-OR of (select & candidate): the selects are early signals, the adders,
+  // comparators and zero tests of count_q the late ones, which enter the last logic levels only
+  // (Fmax). The next count:
+  wire [COUNT_W-1:0] count_inc = count_q + {{(COUNT_W-1){1'b0}}, 1'b1};
+  wire [COUNT_W-1:0] count_dec = count_q - {{(COUNT_W-1){1'b0}}, 1'b1};
+  wire [COUNT_W-1:0] stepped   =  // the count after this clock's step, before the loads
+      ({COUNT_W{k_inc}} & count_inc) | ({COUNT_W{k_dec}} & count_dec) |
+      ({COUNT_W{k_hold}} & count_q) | ({COUNT_W{k_ceil}} & ceil_q);
+
+  (* keep *) wire [COUNT_W-1:0] count_other;  // every case but the adders' (early signals)
+  assign count_other =
+      ({COUNT_W{s_hold}} & count_q) | ({COUNT_W{s_ceil}} & ceil_q) |
+      ({COUNT_W{s_wr}} & wr_val_q) | ({COUNT_W{s_pre}} & preset_q);
 
   always @(*) begin
-    if ((range == R_NON_RECYCLE) & stopped_q) begin
-      zero_other = zero_q;
-    end else if (step_up) begin
-      zero_other = at_max;
-    end else if (step_dn) begin
-      if (at_zero & (range != R_FREE)) begin
-        zero_other = (range == R_MODULO) ? (ceiling == {COUNT_W{1'b0}}) : zero_q;
-      end else begin
-        zero_other = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
-      end
-    end else begin
-      zero_other = zero_q;
-    end
-    if (count_lo_wr) begin
-      zero_other = (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}});
-    end else if (idx_preset) begin
-      zero_other = (preset == {COUNT_W{1'b0}});
-    end
-    zero_d = (up_ceil & at_ceil) ? ((range == R_MODULO) | zero_q) : zero_other;
+    count_d = ({COUNT_W{s_inc}} & count_inc) | ({COUNT_W{s_dec}} & count_dec) | count_other;
   end
+
+  // zero_d = (count_d == 0)
+  wire is_one  = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
+  wire zero_d  = (s_wr & wr_zero_q) | (s_pre & pre_zero_q) |
+                 (s_hold & zero_q) | (s_inc & at_max) | (s_dec & is_one) | s_zero |
+                 (s_ceil & ceil_zero_q);
+
+  // at_ceil_d = (count_d >= ceil_nx_q): each candidate compared with the next clock's ceiling N
+  wire ge_hold = ge_w(count_q, ceil_nx_q);                // count_q     >= N
+  wire ge_m1   = ge_w(count_q, ceil_nx_m1_q);             // count_q + 1 >= N (N > 0, no wrap)
+  wire gt_hold = ~ge_w(ceil_nx_q, count_q);               // count_q - 1 >= N (count_q > 0)
+  // count_q + 1 wraps to 0 only from the maximum (then in the free range: a bounded range stops
+  // or wraps there first, the maximum being >= every ceiling); N = 0: every count is >= N.
+  // count_q - 1 from 0 is the maximum, >= every N.
+  wire at_ceil_d = (s_wr & wr_ge_q) | (s_pre & pre_ge_q) | (s_hold & ge_hold) |
+                   (s_inc & (ceil_nx_zero_q | (ge_m1 & ~at_max))) |
+                   (s_dec & (at_zero | gt_hold)) | (s_zero & ceil_nx_zero_q) |
+                   (s_ceil & ceil_wrap_ge_q);
 
   reg upd_q;  // the count changed (step or load) at the last clock edge
 
@@ -420,11 +483,13 @@ module enc_qei_core #(
     if (rst) begin
       count_q   <= {COUNT_W{1'b0}};
       zero_q    <= 1'b1;
+      at_ceil_q <= ceil_nx_zero_q;
       stopped_q <= 1'b0;
       upd_q     <= 1'b0;
     end else begin
       count_q   <= count_d;
       zero_q    <= zero_d;
+      at_ceil_q <= at_ceil_d;
       stopped_q <= stopped_d;
       upd_q     <= load | took;
     end
@@ -535,6 +600,32 @@ module enc_qei_core #(
   initial count_q = {COUNT_W{1'b0}};
   initial zero_q = 1'b1;
   always @(*) assert (zero_q == (count_q == {COUNT_W{1'b0}}));
+  // ... and the CEILING pipeline's flags agree with its values (initial values: CEILING 0)
+  initial ceil_nx_q = {COUNT_W{1'b0}};
+  initial ceil_nx_m1_q = {COUNT_W{1'b1}};
+  initial ceil_nx_zero_q = 1'b1;
+  initial ceil_q = {COUNT_W{1'b0}};
+  initial ceil_zero_q = 1'b1;
+  initial ceil_wrap_ge_q = 1'b1;
+  initial at_ceil_q = 1'b1;
+  initial wr_q = 1'b0;
+  initial wr_val_q = {COUNT_W{1'b0}};
+  initial wr_ge_q = 1'b1;
+  initial wr_zero_q = 1'b1;
+  initial preset_q = {COUNT_W{1'b0}};
+  initial pre_ge_q = 1'b1;
+  initial pre_zero_q = 1'b1;
+  always @(*) begin
+    assert (ceil_nx_m1_q == ceil_nx_q - {{(COUNT_W-1){1'b0}}, 1'b1});
+    assert (ceil_nx_zero_q == (ceil_nx_q == {COUNT_W{1'b0}}));
+    assert (ceil_zero_q == (ceil_q == {COUNT_W{1'b0}}));
+    assert (ceil_wrap_ge_q == (ceil_q >= ceil_nx_q));
+    assert (at_ceil_q == (count_q >= ceil_q));
+    assert (wr_ge_q == (wr_val_q >= ceil_nx_q));
+    assert (wr_zero_q == (wr_val_q == {COUNT_W{1'b0}}));
+    assert (pre_ge_q == (preset_q >= ceil_nx_q));
+    assert (pre_zero_q == (preset_q == {COUNT_W{1'b0}}));
+  end
 `endif
 
 endmodule

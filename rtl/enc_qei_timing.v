@@ -76,22 +76,22 @@ module enc_qei_timing #(
   localparam [TS_W-1:0] TS_ZERO = {TS_W{1'b0}};
   localparam [TS_W-1:0] TS_MAX  = {TS_W{1'b1}};
   // ---- inputs from the core, registered --------------------------------------------------------------
-  reg edge_any_q, edge_a_rise_q, step_q, up_q, dn_q, dir_change_q;
+  reg edge_any_q, edge_a_rise_q, step_q, dn_q, mv_q, dir_change_q;  // mv_q: a step up or down
 
   always @(posedge clk) begin
     if (rst) begin
       edge_any_q    <= 1'b0;
       edge_a_rise_q <= 1'b0;
       step_q        <= 1'b0;
-      up_q          <= 1'b0;
       dn_q          <= 1'b0;
+      mv_q          <= 1'b0;
       dir_change_q  <= 1'b0;
     end else begin
       edge_any_q    <= edge_any;
       edge_a_rise_q <= edge_a_rise;
       step_q        <= step;
-      up_q          <= applied_up;
       dn_q          <= applied_dn;
+      mv_q          <= applied_up | applied_dn;
       dir_change_q  <= dir_change;
     end
   end
@@ -163,7 +163,9 @@ module enc_qei_timing #(
   end
 
   wire        sel_snap  = snap_edge ? edge_a_rise_q : edge_any_q;
-  wire [31:0] s_now     = up_q ? 32'd1 : dn_q ? 32'hFFFF_FFFF : 32'd0;
+  // +1, -1 or 0 (applied_up and applied_dn never come together): straight from registers into
+  // the adders' carry chains (Fmax)
+  wire [31:0] s_now     = {{31{dn_q}}, mv_q};
   reg  [31:0] delta_q;      // applied steps since the previous snapshot
   reg  [31:0] tail_q;       // applied steps since the last selected edge
   reg  [31:0] head_q;       // steps from the previous snapshot's last selected edge to the last one
@@ -214,25 +216,40 @@ module enc_qei_timing #(
   end
 
   // ---- period ---------------------------------------------------------------------------------------
-  // (per_last_q: PERIOD_CTRL.N - 1, registered, so a new N counts from the clock after the write;
-  // ticks_max_q: ticks_q == all ones, a registered flag)
+  // (n_last_q: n_q == PERIOD_CTRL.N - 1 as of the last clock, so a new N counts from the clock
+  // after the write; ticks_max_q: ticks_q == all ones; both registered flags: Fmax)
   wire       sel_per  = period_edge ? edge_a_rise_q : edge_any_q;
-  reg  [7:0] per_last_q;
   reg        started_q, ovf_q, dir_q, ticks_max_q;
   reg [7:0]  n_q;
   reg [TS_W-1:0] ticks_q;
   reg [TS_W-1:0] period_q;
   reg        period_ovf_q, period_dir_q;
 
-  wire n_last   = (n_q == per_last_q);
+  reg        n_last_q;
+  wire       n_last   = n_last_q;
   wire capture  = period_en & started_q & sel_per & n_last;
   wire saturate = period_en & started_q & ~(sel_per & n_last) & tick & ticks_max_q;
 
+  wire [7:0] per_last_d = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
+  reg  [7:0] n_d;  // n_q's next value (as in the block below)
+
+  always @(*) begin
+    if (!period_en) begin
+      n_d = n_q;
+    end else if (sel_per & (~started_q | n_last)) begin
+      n_d = 8'd0;
+    end else if (started_q & sel_per) begin
+      n_d = n_q + 8'd1;
+    end else begin
+      n_d = n_q;
+    end
+  end
+
   always @(posedge clk) begin
     if (rst) begin
-      per_last_q <= 8'd0;
+      n_last_q <= 1'b1;
     end else begin
-      per_last_q <= (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
+      n_last_q <= (n_d == per_last_d);
     end
   end
 

@@ -2,9 +2,9 @@
 // enc_qei_wb -- enc_qei with a Wishbone B4 classic slave port (32-bit data, byte address).
 //
 // A thin adapter: a strobe of the bus (wb_cyc_i & wb_stb_i) is one request to enc_qei, whose
-// response one clock later is the acknowledge -- wb_ack_o, or wb_err_o for an unmapped offset
-// (which reads 0 and writes nothing). So every access takes two clocks and always completes. No
-// new request starts in the clock of an acknowledge (the master still holds its strobe then).
+// response two clocks later is the acknowledge -- wb_ack_o, or wb_err_o for an unmapped offset
+// (which reads 0 and writes nothing). So every access takes three clocks and always completes.
+// No new request starts until that response (the master still holds its strobe in its clock).
 // wb_sel_i are the byte enables of a write. All the peripheral's behaviour is in enc_qei.
 `default_nettype none
 
@@ -68,6 +68,18 @@ module enc_qei_wb #(
   endgenerate
 
   wire resp_valid, resp_err;
+  reg  busy_q;  // a request is in enc_qei: from the clock after it until its response
+  wire req_valid = wb_cyc_i & wb_stb_i & ~busy_q;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      busy_q <= 1'b0;
+    end else if (req_valid) begin
+      busy_q <= 1'b1;
+    end else if (resp_valid) begin
+      busy_q <= 1'b0;
+    end
+  end
 
   enc_qei #(
       .COUNT_W   (COUNT_W),
@@ -77,7 +89,7 @@ module enc_qei_wb #(
   ) u_qei (
       .clk       (clk),
       .rst       (rst),
-      .req_valid (wb_cyc_i & wb_stb_i & ~resp_valid),
+      .req_valid (req_valid),
       .req_write (wb_we_i),
       .req_addr  (wb_adr_i),
       .req_wdata (wb_dat_i),

