@@ -94,14 +94,15 @@ def _qei(*names: str) -> list[str]:
 
 
 G = "test_enc_qei_gaps."
-# Every enc_qei cocotb test of test_enc_qei.py and test_enc_qei_gaps.py (its expect_fail
-# reproducer left out: it cannot kill), cheapest and most killing first.
+# Every enc_qei cocotb test of test_enc_qei.py and test_enc_qei_gaps.py, cheapest and most
+# killing first.
 QEI_ALL = _qei(
     "register_walk", G + "register_patterns", "events_and_irq", "reset_mid_motion",
     G + "irq_low_in_reset", G + "wb_abandoned_cycle",
     "byte_enables", "unmapped_offsets", "coherent_64bit", "index_gate_same_position", "probe",
     "compare", G + "concurrent_reads_and_writes", "stall_and_recovery",
     G + "snapshot_wide_values", G + "latches_wide", G + "step_soon_after_reset",
+    G + "reset_in_each_state",
     G + "reset_on_rejection_clock", "prescaler_and_snap_in", "snapshot_deltas_across_wraps",
     "filter_lengths", G + "filter_len_clamp", G + "byte_enables_all", G + "swap_and_invert",
     G + "period_large_n", G + "stall_timeout_exact", G + "probe_time_exact",
@@ -126,7 +127,8 @@ _QEI_OWN = {t.split(".")[1] for t in QEI_ALL if t.startswith("test_enc_qei.")}
 QEI_ORDER = {
     "enc_conditioner_rt": qei_first(
         "register_walk", "reset_mid_motion", "events_and_irq", "byte_enables", "filter_lengths",
-        "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset"),
+        "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset",
+        "reset_in_each_state"),
     "enc_qei_core": qei_first(
         "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
         "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",

@@ -221,18 +221,12 @@ async def pulse_rst(dut, clocks=1):
     dut.rst.value = 0
 
 
-@cocotb.test(expect_fail=True)
+@cocotb.test()
 async def reset_in_each_state(dut):
     """rst with the shaft standing in each of the four states (inputs held through the reset):
     the peripheral takes that state as its reference: count 0, no QERR, no GLITCH; then it counts
-    exactly from there.
-
-    EXPECTED TO FAIL with the present RTL (reported with issue 14's mutation run): after rst,
-    enc_conditioner_rt's `valid` rises one clock before its outputs show the inputs (FILTER_LEN 3:
-    valid at the 4th rising edge after rst falls, a/b at the 5th; its header says filter_len + 2
-    clocks), so the core's x4 decoder takes 00 as its reference and then sees the real state: a
-    QERR (state 11) or a count of +-1 (01, 10) after every reset with the shaft not in 00. Remove
-    expect_fail when that is fixed."""
+    exactly from there. (Written as the reproducer of a bug make mutate led to: `valid` rose one
+    clock before the conditioner showed the inputs; fixed in enc_conditioner_rt, d197bf9.)"""
     env, rng = await begin(dut)
     bus = env.bus
     for pos in (2, 1, 3, 0, 2):
