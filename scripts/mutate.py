@@ -107,8 +107,8 @@ QEI_ALL = _qei(
     "filter_lengths", G + "filter_len_clamp", G + "byte_enables_all", G + "swap_and_invert",
     G + "period_large_n", G + "stall_timeout_exact", G + "probe_time_exact",
     "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
-    "heds_unit_profile", G + "prescaler_long", "period_capture", G + "unit_timer_period",
-    "func_walks")
+    "heds_unit_profile", G + "prescaler_long", G + "error_counters_wide", "period_capture",
+    G + "unit_timer_period", "func_walks")
 
 
 def qei_first(*names: str) -> list[str]:

@@ -179,6 +179,34 @@ async def prescaler_long(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
+@cocotb.test()
+async def error_counters_wide(dut):
+    """QERR_COUNT and GLITCH_COUNT past 1,024 (bits 10 and up): 1,100 illegal jumps and 1,100
+    lone one-clock pulses are each counted."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    n = 1100
+    await env.setup(model, func="x4", filter_len=1, count=0)
+    await env.drv.play(walk([2] * n, [3 * T_NS] * n, start_pos=env.pos))
+    env.pos += 2 * n
+    await env.settle(10)
+    assert await bus.rd("QERR_COUNT") == n, "QERR_COUNT after 1,100 illegal jumps"
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=2))
+    await env.settle(10)
+    await bus.wr("GLITCH_COUNT", 0)
+    a = QUAD[env.pos % 4][0]
+    for _ in range(n):
+        await FallingEdge(dut.clk)
+        dut.a_in.value = 1 - a
+        await FallingEdge(dut.clk)
+        dut.a_in.value = a
+        await ClockCycles(dut.clk, 2)
+    await env.settle(10)
+    assert await bus.rd("GLITCH_COUNT") == n, "GLITCH_COUNT after 1,100 lone pulses"
+    await bus.events()
+
+
 # ---- conditioner (enc_conditioner_rt) -------------------------------------------------------------------
 @cocotb.test()
 async def filter_len_clamp(dut):
