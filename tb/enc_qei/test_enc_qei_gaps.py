@@ -461,9 +461,9 @@ async def byte_enables_all(dut):
     masks = [1, 2, 4, 8, 3, 6, 12, 7, 14] + ([5, 9, 10, 13, 11] if bus.kind == "wb" else [])
     for i, r in enumerate(_cfg_regs()):
         m, fm = _cfg_mask(r, count_w, ts_w), _cfg_fields(r)
-        for k, strb in enumerate(masks):
+        for k, (strb, flip) in enumerate((m, f) for m in masks for f in (0, 0xFFFFFFFF)):
             lanes = sum(0xFF << 8 * j for j in range(4) if strb >> j & 1)
-            old = (0xC3A55A3C * (i + 3 * k + 1)) & 0xFFFFFFFF
+            old = ((0xC3A55A3C * (i + 3 * k + 1)) ^ flip) & 0xFFFFFFFF  # each bit kept as 0 and as 1
             new = ~old & 0xFFFFFFFF
             await bus.wr(r.name, old)
             await bus.wr(r.name, new, strb)
