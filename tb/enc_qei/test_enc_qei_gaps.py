@@ -36,7 +36,7 @@ async def unit_timer_period(dut):
     bus = env.bus
     ts_mask = (1 << int(dut.TS_W.value)) - 1
     for pre, p in ((0, 0), (0, 1), (0, 2), (0, 3), (0, 0x5A), (0, 0x1A5), (1, 0xC3),
-                   (0, 0x2C3), (0, 0x6F0), (0, 0x80F), (0, 0x1003)):
+                   (0, 0x2C3), (0, 0x200), (0, 0x6F0), (0, 0x80F), (0, 0x1003)):
         step = max(p, 1)
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("SNAP_PERIOD", p)
@@ -117,7 +117,7 @@ async def stall_timeout_exact(dut):
     await bus.wr("IRQ_EN", event_bits("STALL"))
     clocks = {}
     for pre, t in ((0, 0x40), (0, 0x2F), (0, 0x1F0), (0, 0x2A5), (0, 0x35A), (0, 0x0CB), (0, 0x104),
-                   (0, 2), (0, 1), (2, 0x40), (2, 0x13), (2, 0x6D)):
+                   (0, 0x20), (0, 0x200), (0, 2), (0, 1), (2, 0x40), (2, 0x13), (2, 0x6D)):
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("STALL_TIMEOUT", t)
         await Timer((t * (pre + 1) + 40) * PERIOD_PS, unit="ps")  # any stall of the wait is over
