@@ -107,6 +107,7 @@ QEI_ALL = _qei(
     "filter_lengths", G + "filter_len_clamp", G + "byte_enables_all", G + "swap_and_invert",
     G + "period_large_n", G + "stall_timeout_exact", G + "probe_time_exact",
     "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
+    G + "bounded_range_fast",
     "heds_unit_profile", G + "prescaler_long", G + "error_counters_wide", "period_capture",
     G + "unit_timer_period", "func_walks")
 
@@ -132,7 +133,7 @@ QEI_ORDER = {
     "enc_qei_core": qei_first(
         "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
         "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",
-        "range_modes", "index", "ceiling_wide"),
+        "range_modes", "index", "ceiling_wide", "bounded_range_fast"),
     "enc_qei_timing": qei_first(
         "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "stall_timeout_exact",
         "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",

@@ -405,6 +405,23 @@ async def ceiling_wide(dut):
                 await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}")
 
 
+@cocotb.test()
+async def bounded_range_fast(dut):
+    """RANGE modulo and limit at the count-rate bound (FILTER_LEN 1, states of 1.05 .. 2.1 clocks,
+    many reversals: steps in consecutive clocks both ways), CEILINGs with high bits, counts on
+    both sides of slice boundaries: COUNT and events equal the model's."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    for mode, ceiling, start in (("modulo", 0x1_0000_0040, 0x1_0000_0020), ("limit", 0x2_0001_0010, 0x2_0000_FFF8),
+                                 ("modulo", 0x30, 0x2E), ("limit", 0x1_0018, 0xFFF0)):
+        ceiling &= model.max
+        start &= model.max
+        await env.setup(model, rng_mode=mode, filter_len=1, count=min(start, ceiling), ceiling=ceiling)
+        wf = random_walk(rng, 600, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
+        await env.play(wf, model)
+        await env.check(model, f"{mode} CEILING {ceiling:#x} fast")
+
+
 # ---- register block -----------------------------------------------------------------------------------------
 def _cfg_regs():
     """Registers with a storage (cfg) field and no write side effect the walk would disturb."""
