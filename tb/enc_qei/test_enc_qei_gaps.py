@@ -412,14 +412,32 @@ async def bounded_range_fast(dut):
     both sides of slice boundaries: COUNT and events equal the model's."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
+    bus = env.bus
     for mode, ceiling, start in (("modulo", 0x1_0000_0040, 0x1_0000_0020), ("limit", 0x2_0001_0010, 0x2_0000_FFF8),
-                                 ("modulo", 0x30, 0x2E), ("limit", 0x1_0018, 0xFFF0)):
+                                 ("modulo", 0x30, 0x2E), ("limit", 0x1_0018, 0xFFF0),
+                                 ("limit", 0xFFF0, 0x1_0008), ("modulo", 0x1_FFF0, 0x2_0004)):
         ceiling &= model.max
         start &= model.max
-        await env.setup(model, rng_mode=mode, filter_len=1, count=min(start, ceiling), ceiling=ceiling)
+        await env.setup(model, rng_mode=mode, filter_len=1, count=start, ceiling=ceiling)
         wf = random_walk(rng, 600, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
         await env.play(wf, model)
-        await env.check(model, f"{mode} CEILING {ceiling:#x} fast")
+        await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x} fast")
+    # index presets near CEILING (in other 16-bit slices too), steps right after them
+    for mode, ceiling, preset in (("limit", 0x0800_1234, 0x0800_1230), ("modulo", 0x0800_1234, 0x0801_0000),
+                                  ("limit", 0x1_0000, 0xFFFF), ("modulo", 0x0C00_0000, 0x0BFF_FFFE)):
+        ceiling &= model.max
+        preset &= model.max
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+        await bus.set64("PRESET", preset)
+        model.preset = preset
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+        model.idx_gate, model.idx_arm = None, True
+        wf = random_walk(rng, 400, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
+        await env.play(wf, model, zfun=lambda p: int(p % 7 == 0))
+        await env.check(model, f"{mode} CEILING {ceiling:#x} PRESET {preset:#x} fast")
+        await bus.wr("INDEX_CTRL", 0)
+        model.idx_action = "none"
 
 
 # ---- register block -----------------------------------------------------------------------------------------
