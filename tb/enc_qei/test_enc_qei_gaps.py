@@ -415,7 +415,8 @@ async def bounded_range_fast(dut):
     bus = env.bus
     for mode, ceiling, start in (("modulo", 0x1_0000_0040, 0x1_0000_0020), ("limit", 0x2_0001_0010, 0x2_0000_FFF8),
                                  ("modulo", 0x30, 0x2E), ("limit", 0x1_0018, 0xFFF0),
-                                 ("limit", 0xFFF0, 0x1_0008), ("modulo", 0x1_FFF0, 0x2_0004)):
+                                 ("limit", 0xFFF0, 0x1_0008), ("modulo", 0x1_FFF0, 0x2_0004),
+                                 ("modulo", 0, 0), ("limit", 0, 0), ("modulo", 0x8000_8001, 3)):
         ceiling &= model.max
         start &= model.max
         await env.setup(model, rng_mode=mode, filter_len=1, count=start, ceiling=ceiling)
