@@ -40,6 +40,12 @@ Options:
   --rev REV        the RTL of a git revision (e.g. HEAD) instead of the working tree
   --mutation CMD   run given mutations instead (with one --only module): how the deterministic
                    tests were shown to kill the mutants of issue 14, see doc/mutation.md
+  --no-results     do not write doc/results/mutation.md
+  --report         run nothing: write the last run's table (build/mutate/seed<S>/results.json)
+                   again, with the reasons now in scripts/mutate_reviewed.txt
+  --results A,B    with --report: the results.json of several runs (of different modules) as
+                   one table
+  --work NAME      work in build/mutate/NAME instead of build/mutate/seed<S>
 """
 
 from __future__ import annotations
@@ -47,8 +53,10 @@ from __future__ import annotations
 import argparse
 import concurrent.futures
 import hashlib
+import json
 import os
 import re
+import resource
 import shlex
 import shutil
 import subprocess
@@ -72,6 +80,96 @@ T_COND = "tb/enc_conditioner/test_enc_conditioner.py"
 T_RATE = "tb/count_rate/test_count_rate.py"
 T_BUF = "tb/enc_updown_buffer/test_enc_updown_buffer.py"
 T_PHASE = "tb/enc_phase_meter/test_enc_phase_meter.py"
+T_QEI_MUT = "tb/enc_qei/mutate_enc_qei.py::test_enc_qei_mutate"
+
+# The enc_qei modules run the regression's enc_qei cocotb tests (test_enc_qei.py and
+# test_enc_qei_gaps.py, the count-rate tests of qei_count_rate.py) through
+# tb/enc_qei/mutate_enc_qei.py, which builds test_enc_qei.py's two configurations and runs, in the
+# order given (ENC_QEI_MUT_TESTS, the third element of a corner), the listed cocotb tests, stopping
+# at the first failure (tb/enc_qei/qei_mutate_suite.py). Cheapest first; a module's list is every
+# test that exercises it.
+def _qei(*names: str) -> list[str]:
+    """cocotb test ids: names from test_enc_qei.py, or module.name."""
+    return [n if "." in n else f"test_enc_qei.{n}" for n in names]
+
+
+G = "test_enc_qei_gaps."
+# Every enc_qei cocotb test of test_enc_qei.py and test_enc_qei_gaps.py, cheapest and most
+# killing first.
+QEI_ALL = _qei(
+    "register_walk", G + "register_patterns", "events_and_irq", "reset_mid_motion",
+    G + "irq_low_in_reset", G + "wb_abandoned_cycle",
+    "byte_enables", "unmapped_offsets", "coherent_64bit", "index_gate_same_position", "probe",
+    "compare", G + "concurrent_reads_and_writes", "stall_and_recovery",
+    G + "snapshot_wide_values", G + "latches_wide", G + "step_soon_after_reset",
+    G + "reset_in_each_state",
+    G + "reset_on_rejection_clock", "prescaler_and_snap_in", "snapshot_deltas_across_wraps",
+    "filter_lengths", G + "filter_len_clamp", G + "byte_enables_all", G + "swap_and_invert",
+    G + "period_large_n", G + "stall_timeout_exact", G + "probe_time_exact",
+    "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
+    G + "bounded_range_fast",
+    "heds_unit_profile", G + "prescaler_long", G + "error_counters_wide", "period_capture",
+    G + "unit_timer_period", "func_walks")
+
+
+def qei_first(*names: str) -> list[str]:
+    """QEI_ALL with these tests first (a module's likeliest killers, cheapest first): every
+    mutant still runs every test until one fails, only the order differs."""
+    head = _qei(*(n if "." in n or n in _QEI_OWN else G + n for n in names))
+    missing = [h for h in head if h not in QEI_ALL]
+    if missing:
+        raise ValueError(f"not in QEI_ALL: {missing}")
+    return head + [t for t in QEI_ALL if t not in head]
+
+
+_QEI_OWN = {t.split(".")[1] for t in QEI_ALL if t.startswith("test_enc_qei.")}
+
+# per module: the tests that killed most of its mutants (seed 1) first
+QEI_ORDER = {
+    "enc_conditioner_rt": qei_first(
+        "register_walk", "reset_mid_motion", "events_and_irq", "byte_enables", "filter_lengths",
+        "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset",
+        "reset_in_each_state"),
+    "enc_qei_core": qei_first(
+        "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
+        "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",
+        "range_modes", "index", "ceiling_wide", "bounded_range_fast"),
+    "enc_qei_timing": qei_first(
+        "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "stall_timeout_exact",
+        "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",
+        "snapshot_coherence", "unit_timer_period", "period_capture"),
+    "enc_qei_regs": qei_first(
+        "register_walk", "register_patterns", "byte_enables", "byte_enables_all",
+        "reset_mid_motion", "events_and_irq", "unmapped_offsets", "irq_low_in_reset",
+        "probe_time_exact", "snapshot_wide_values", "latches_wide"),
+    "enc_qei": qei_first(
+        "register_walk", "register_patterns", "events_and_irq", "irq_low_in_reset",
+        "reset_mid_motion", "index_gate_same_position", "swap_and_invert",
+        "snapshot_deltas_across_wraps", "snapshot_wide_values"),
+    "bus": qei_first(
+        "register_walk", "register_patterns", "wb_abandoned_cycle", "concurrent_reads_and_writes",
+        "events_and_irq", "reset_mid_motion", "byte_enables", "unmapped_offsets"),
+}
+
+# the count-rate tests (test_count_rate_qei.py builds enc_qei_wb at COUNT_W 32 / TS_W 32 too)
+QEI_RATE = ["qei_count_rate.never_silent", "qei_count_rate.exact_at_bound"]
+# what enc_qei instantiates, and an adapter (enc_qei and all that): -lib in the elaboration, read
+# in full (flattened) by the equivalence check of a survivor
+QEI_DEPS = ["rtl/enc_conditioner_rt.v", "rtl/enc_qei_core.v", "rtl/enc_x4_decoder.v",
+            "rtl/enc_x1_hysteresis.v", "rtl/enc_qei_timing.v", "rtl/enc_qei_regs.v"]
+QEI_DEPS_TOP = ["rtl/enc_qei.v"] + QEI_DEPS
+QEI_WB, QEI_AXIL = f"{T_QEI_MUT}[enc_qei_wb-c32-t32]", f"{T_QEI_MUT}[enc_qei_axil-c64-t16]"
+
+
+def qei_corners(wb: list[str] | None, axil: list[str] | None, params: bool = True) -> list:
+    """The corners of an enc_qei module: COUNT_W 32 / TS_W 32 (enc_qei_wb) and 64 / 16
+    (enc_qei_axil), each with its ordered cocotb test list (None: no corner there)."""
+    out = []
+    for cfg, (cw, tw), tests in ((QEI_WB, (32, 32), wb), (QEI_AXIL, (64, 16), axil)):
+        if tests is not None:
+            out.append(({"COUNT_W": cw, "TS_W": tw} if params else {}, [cfg], tests))
+    return out
+
 
 # module -> its source, the sources of the modules it instantiates, and per parameter corner the
 # pytest ids of the tests that run it there (fastest first: pytest -x stops at the first failure).
@@ -129,6 +227,42 @@ MODULES: dict[str, dict] = {
         "file": "rtl/enc_characterizer.v",
         "corners": [({"CNT_W": 12, "WINDOW_CYCLES": 32},
                      ["tb/enc_characterizer/test_enc_characterizer.py::test_enc_characterizer"])],
+    },
+    # enc_qei's parts (issue 12/13). enc_conditioner_rt has no parameter the configurations change
+    # (MAX_FILTER_LEN 16 in both): one corner, in the cheaper enc_qei_wb build. The bus adapters'
+    # logic does not depend on COUNT_W / TS_W (they only pass them on): each at its own
+    # configuration.
+    "enc_conditioner_rt": {
+        "file": "rtl/enc_conditioner_rt.v",
+        "corners": [({"MAX_FILTER_LEN": 16}, [QEI_WB], QEI_ORDER["enc_conditioner_rt"] + QEI_RATE)],
+    },
+    "enc_qei_core": {
+        "file": "rtl/enc_qei_core.v",
+        "deps": ["rtl/enc_x4_decoder.v", "rtl/enc_x1_hysteresis.v"],
+        "corners": qei_corners(QEI_ORDER["enc_qei_core"] + QEI_RATE, QEI_ORDER["enc_qei_core"]),
+    },
+    "enc_qei_timing": {
+        "file": "rtl/enc_qei_timing.v",
+        "corners": qei_corners(QEI_ORDER["enc_qei_timing"], QEI_ORDER["enc_qei_timing"]),
+    },
+    "enc_qei_regs": {
+        "file": "rtl/enc_qei_regs.v",
+        "corners": qei_corners(QEI_ORDER["enc_qei_regs"], QEI_ORDER["enc_qei_regs"]),
+    },
+    "enc_qei": {
+        "file": "rtl/enc_qei.v",
+        "deps": QEI_DEPS,
+        "corners": qei_corners(QEI_ORDER["enc_qei"], QEI_ORDER["enc_qei"]),
+    },
+    "enc_qei_wb": {
+        "file": "rtl/enc_qei_wb.v",
+        "deps": QEI_DEPS_TOP,
+        "corners": qei_corners(QEI_ORDER["bus"], None),
+    },
+    "enc_qei_axil": {
+        "file": "rtl/enc_qei_axil.v",
+        "deps": QEI_DEPS_TOP,
+        "corners": qei_corners(None, QEI_ORDER["bus"]),
     },
 }
 
@@ -200,6 +334,7 @@ class Corner:
     params: dict
     tests: list[str]
     index: int
+    cocotb_tests: list[str] = field(default_factory=list)  # ENC_QEI_MUT_TESTS: ordered subset
     baseline_s: float = 0.0
     error: str = ""
 
@@ -250,7 +385,7 @@ class Mutant:
 
     def describe(self) -> str:
         o = self.opts
-        cell = o.get("cell", "").replace(f"{SNAPSHOT}/", "")
+        cell = unsnap(o.get("cell", ""))
         what = f"{o.get('mode')} {cell}.{o.get('port')}[{o.get('portbit')}]"
         if "ctrlbit" in o:
             what += f" ctrl[{o['ctrlbit']}]"
@@ -258,9 +393,14 @@ class Mutant:
             what += f" ({o['wire']}[{o.get('wirebit')}])"
         srcs = sorted(o.get("src", []), key=lambda x: len(src_text(x)))  # innermost first
         if srcs:
-            loc = srcs[0].split("-")[0].rsplit(".", 1)[0].replace(f"{SNAPSHOT}/", "")
+            loc = unsnap(srcs[0].split("-")[0].rsplit(".", 1)[0])
             what += f" at {loc} `{src_text(srcs[0])[:60]}`"
         return what
+
+
+def unsnap(text: str) -> str:
+    """A path into any run's RTL copy (build/mutate/<work>/src/rtl/x.v) as rtl/x.v."""
+    return re.sub(r"build/mutate/[^/\s]+/src/", "", text)
 
 
 def parse_mutate(command: str) -> dict:
@@ -313,7 +453,10 @@ def chparams(c: Corner) -> str:
     defaults = module_defaults(TOP / snap(c.file))
     params = {k: defaults[k] for k in defaults}
     params.update({k: str(v) for k, v in c.params.items()})
-    return " ".join(f"-chparam {k} {v}" for k, v in params.items())
+    # Yosys cannot decode a negative -chparam value (enc_qei_regs's FIXED_FUNC = -1): a default
+    # that is not a plain non-negative number stays as the module declares it
+    return " ".join(f"-chparam {k} {v}" for k, v in params.items()
+                    if k in c.params or v.isdigit())
 
 
 def param_decls(c: Corner) -> str:
@@ -340,6 +483,15 @@ def add_params(verilog: str, c: Corner) -> str:
     if not m:
         raise RuntimeError(f"no module header for {c.module} in the written Verilog")
     return verilog[:m.end()] + param_decls(c) + verilog[m.end():]
+
+
+def generate_scopes(verilog: str) -> str:
+    """write_verilog flattens a generate block's instance into one escaped name (`\\g_timing.u_timing`
+    in enc_qei); the tests reach into it by its hierarchical path (dut.u_qei.g_timing.u_timing),
+    so put it back into a named block: `if (1) begin : g_timing ... u_timing (...); end`."""
+    pat = re.compile(r"^(  \w+(?: #\([^;]*?\n  \))?) \\(\w+)\.(\w+) +(\([^;]*?\n  \);\n)", re.M)
+    return pat.sub(lambda m: f"  if (1) begin : {m.group(2)}\n{m.group(1)} {m.group(3)} {m.group(4)}"
+                             f"  end\n", verilog)
 
 
 def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None = None) -> list[Mutant]:
@@ -373,7 +525,7 @@ def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None =
                            f"{proc.stdout}{proc.stderr}")
     for i in range(len(mutants) + 1):
         p = d / f"m{i:02d}.v"
-        p.write_text(add_params(p.read_text(), c))
+        p.write_text(generate_scopes(add_params(p.read_text(), c)))
     for m in mutants:
         m.path = d / f"m{m.number:02d}.v"
     return mutants
@@ -390,7 +542,8 @@ def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: fl
     override[c.file] = verilog
     env.update(ENC_RTL_OVERRIDE=",".join(f"{k}={v}" for k, v in override.items()),
                ENC_BUILD_ROOT=str(build), SIM="icarus",
-               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1")
+               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1",
+               ENC_QEI_MUT_TESTS=",".join(c.cocotb_tests))
     env.pop("WAVES", None)
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
            "-rf", *c.tests]
@@ -514,7 +667,18 @@ def main() -> int:
                     "mutate -list, on the one --only module at each of its corners; cell names "
                     "as in build/mutate/seed*/<module>_<corner>/orig.il")
     ap.add_argument("--no-results", action="store_true", help="do not write doc/results/mutation.md")
+    ap.add_argument("--report", action="store_true",
+                    help="run nothing: write the table of the last run (build/mutate/seed<S>/"
+                    "results.json) again, with the reasons now in scripts/mutate_reviewed.txt")
+    ap.add_argument("--work", default="", metavar="NAME",
+                    help="work directory build/mutate/NAME (default seed<S>): two runs of "
+                    "different modules at once need two")
+    ap.add_argument("--results", default="", metavar="JSON[,JSON]",
+                    help="with --report: these results.json files (runs of different modules, "
+                    "e.g. copies kept from earlier runs), as one table")
     args = ap.parse_args()
+    if args.report:
+        return report_again(args)
     if args.jobs < 1:
         ap.error("--jobs must be >= 1")
 
@@ -527,16 +691,19 @@ def main() -> int:
         ap.error("--mutation needs exactly one module in --only")
     if args.mutation:
         args.no_results = True
-    corners = [Corner(mod, params, tests, i)
-               for mod in modules for i, (params, tests) in enumerate(MODULES[mod]["corners"])]
+    corners = [Corner(mod, params, tests, i, list(rest[0]) if rest else [])
+               for mod in modules
+               for i, (params, tests, *rest) in enumerate(MODULES[mod]["corners"])]
     if args.list:
         for c in corners:
             n = args.n or MODULES[c.module].get("n", DEFAULT_N)
-            print(f"{c.module:18s} {c.label:32s} N={n:<3d} {' '.join(c.tests)}")
+            print(f"{c.module:18s} {c.label:32s} N={n:<3d} {' '.join(c.tests)}"
+                  + (f" [{','.join(c.cocotb_tests)}]" if c.cocotb_tests else ""))
         return 0
 
     t_start = time.monotonic()
-    root = TOP / BUILD_REL / (f"seed{args.seed}" if not args.mutation else "given")
+    load_start = os.getloadavg()
+    root = TOP / BUILD_REL / (args.work or (f"seed{args.seed}" if not args.mutation else "given"))
     if root.exists():
         shutil.rmtree(root)
     root.mkdir(parents=True)
@@ -613,10 +780,60 @@ def main() -> int:
         list(pool.map(one, todo))
 
     elapsed = time.monotonic() - t_start
-    return report(modules, corners, mutants, reviewed, args, elapsed)
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    run = {"elapsed": elapsed, "cpu": ru.ru_utime + ru.ru_stime, "jobs": args.jobs,
+           "load": [round(x, 1) for x in load_start + os.getloadavg()],
+           "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+    save_results(root, modules, corners, mutants, run)
+    return report(modules, corners, mutants, reviewed, args, elapsed, run)
 
 
-def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
+def save_results(root: Path, modules, corners, mutants, run: dict) -> None:
+    """The run's outcome (build/mutate/seed<S>/results.json), for `--report`."""
+    data = {"run": run, "modules": modules, "snapshot": str(SNAPSHOT),
+            "corners": [{"module": c.module, "params": c.params, "tests": c.tests, "index": c.index,
+                         "cocotb_tests": c.cocotb_tests, "baseline_s": c.baseline_s}
+                        for c in corners],
+            "mutants": [{"corner": corners.index(m.corner), "number": m.number,
+                         "command": m.command, "path": str(m.path), "result": m.result,
+                         "seconds": m.seconds, "failed_test": m.failed_test, "eq_note": m.eq_note,
+                         "opts": m.opts} for m in mutants]}
+    (root / "results.json").write_text(json.dumps(data, indent=1))
+
+
+def report_again(args) -> int:
+    """The table of earlier runs, from their results.json; several runs (of different modules)
+    are summed into one table: wall and CPU time added, each run's load kept."""
+    global SNAPSHOT
+    paths = ([Path(p) for p in args.results.split(",") if p] if args.results
+             else [TOP / BUILD_REL / f"seed{args.seed}" / "results.json"])
+    modules, corners, mutants, runs = [], [], [], []
+    for path in paths:
+        path = path if path.is_absolute() else TOP / path
+        if not path.exists():
+            sys.exit(f"mutate --report: no {path}; run make mutate first")
+        data = json.loads(path.read_text())
+        SNAPSHOT = Path(data["snapshot"])  # the same for every run of one seed
+        cs = [Corner(c["module"], c["params"], c["tests"], c["index"], c["cocotb_tests"],
+                     c["baseline_s"]) for c in data["corners"]]
+        mutants += [Mutant(cs[m["corner"]], m["number"], m["command"], Path(m["path"]),
+                           m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
+                    for m in data["mutants"]]
+        modules += [m for m in data["modules"] if m not in modules]
+        corners += cs
+        runs.append(data["run"])
+    modules = [m for m in MODULES if m in modules] + [m for m in modules if m not in MODULES]
+    corners.sort(key=lambda c: (modules.index(c.module), c.index))
+    run = dict(runs[-1])
+    run["elapsed"] = sum(r["elapsed"] for r in runs)
+    run["cpu"] = sum(r.get("cpu", 0) for r in runs)
+    if len(runs) > 1:
+        run["parts"] = runs
+    args.jobs = run["jobs"]
+    return report(modules, corners, mutants, load_reviewed(), args, run["elapsed"], run)
+
+
+def report(modules, corners, mutants, reviewed, args, elapsed, run: dict) -> int:
     rows = []
     for mod in modules:
         ms = [m for m in mutants if m.corner.module == mod]
@@ -648,7 +865,18 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
         print("  ".join(v.ljust(w) if j == 0 else v.rjust(w) for j, (v, w) in enumerate(zip(r, widths))))
         if i == 0:
             print("  ".join("-" * w for w in widths))
-    print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min")
+    def load_of(r: dict) -> str:
+        ld = r.get("load", [])
+        return (f"load average {ld[0]} at the start, {ld[3]} at the end (1-min)"
+                if len(ld) == 6 else "")
+
+    load_txt = load_of(run)
+    if run.get("parts"):
+        load_txt = f"in {len(run['parts'])} runs: " + "; ".join(
+            f"{r['elapsed'] / 60:.1f} min wall, {r.get('cpu', 0) / 60:.1f} CPU-min, {load_of(r)}, "
+            f"{r.get('date', '')}" for r in run["parts"])
+    print(f"\nseed {args.seed}, {tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall, "
+          f"{run.get('cpu', 0) / 60:.1f} CPU-min; {load_txt}")
 
     surv = [m for m in mutants if m.result == "survived"]
     unreviewed = [m for m in surv if m.mutant_id() not in reviewed]
@@ -660,7 +888,8 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
         md = ["# Mutation coverage", "",
               f"`make mutate` (scripts/mutate.py; how it works: doc/mutation.md). Seed {args.seed}, "
               f"{tot_gen} mutants, {args.jobs} jobs, {elapsed / 60:.1f} min wall time, "
-              f"{time.strftime('%Y-%m-%d', time.gmtime())}.", "",
+              f"{run.get('cpu', 0) / 60:.1f} CPU-minutes (user + system of the tools it ran), "
+              f"{load_txt}, {run.get('date', '')}.", "",
               "| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
         md += ["| " + " | ".join(r) + " |" for r in table[1:]]
         md += ["", "Score = killed / (generated - equivalent). A timeout counts as killed. "
@@ -669,8 +898,13 @@ def report(modules, corners, mutants, reviewed, args, elapsed) -> int:
                "## Corners and tests", "", "| module | corner | tests | unmutated run (s) |",
                "|---|---|---|---:|"]
         for c in corners:
-            md.append(f"| {c.module} | {c.label} | {'<br>'.join(t.split('/')[-1] for t in c.tests)} "
-                      f"| {c.baseline_s:.1f} |")
+            tests = '<br>'.join(t.split('/')[-1] for t in c.tests)
+            if c.cocotb_tests:
+                tests += (f" ({len(c.cocotb_tests)} cocotb tests of test_enc_qei.py, "
+                          f"test_enc_qei_gaps.py" + (", qei_count_rate.py" if any(
+                              t.startswith("qei_count_rate.") for t in c.cocotb_tests) else "")
+                          + ", first failure ends the run)")
+            md.append(f"| {c.module} | {c.label} | {tests} | {c.baseline_s:.1f} |")
         md += ["", "## Survivors and equivalent mutants", ""]
         listed = [m for m in mutants if m.result in ("survived", "equivalent")]
         if listed:
