@@ -117,7 +117,8 @@ async def stall_timeout_exact(dut):
     await bus.wr("IRQ_EN", event_bits("STALL"))
     clocks = {}
     for pre, t in ((0, 0x40), (0, 0x2F), (0, 0x1F0), (0, 0x2A5), (0, 0x35A), (0, 0x0CB), (0, 0x104),
-                   (0, 0x20), (0, 0x200), (0, 2), (0, 1), (2, 0x40), (2, 0x13), (2, 0x6D)):
+                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
+                   (2, 0x6D)):
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("STALL_TIMEOUT", t)
         await Timer((t * (pre + 1) + 40) * PERIOD_PS, unit="ps")  # any stall of the wait is over
