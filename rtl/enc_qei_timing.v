@@ -231,7 +231,7 @@ module enc_qei_timing #(
   wire saturate = period_en & started_q & ~(sel_per & n_last) & tick & ticks_max_q;
 
   wire [7:0] per_last_d = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
-  reg  [7:0] n_d;  // n_q's next value (as in the block below)
+  reg  [7:0] n_d;  // n_q's next value
 
   always @(*) begin
     if (!period_en) begin
@@ -247,8 +247,10 @@ module enc_qei_timing #(
 
   always @(posedge clk) begin
     if (rst) begin
+      n_q      <= 8'd0;
       n_last_q <= 1'b1;
     end else begin
+      n_q      <= n_d;
       n_last_q <= (n_d == per_last_d);
     end
   end
@@ -258,7 +260,6 @@ module enc_qei_timing #(
       started_q    <= 1'b0;
       ovf_q        <= 1'b0;
       dir_q        <= 1'b0;
-      n_q          <= 8'd0;
       ticks_q      <= TS_ZERO;
       ticks_max_q  <= 1'b0;
       period_q     <= TS_ZERO;
@@ -271,7 +272,6 @@ module enc_qei_timing #(
       started_q   <= 1'b1;
       ovf_q       <= 1'b0;
       dir_q       <= 1'b0;
-      n_q         <= 8'd0;
       ticks_q     <= tick ? TS_ONE : TS_ZERO;
       ticks_max_q <= 1'b0;
       if (started_q) begin  // (capture)
@@ -280,9 +280,6 @@ module enc_qei_timing #(
         period_dir_q <= dir_q | dir_change_q;
       end
     end else if (started_q) begin
-      if (sel_per) begin
-        n_q <= n_q + 8'd1;
-      end
       dir_q <= dir_q | dir_change_q;
       if (tick) begin
         if (ticks_max_q) begin
