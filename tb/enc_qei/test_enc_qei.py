@@ -66,7 +66,9 @@ class Env:
             index = [(t, zfun(p)) for (t, _, _), p in zip(wf.events, wf.positions)]
         await self.drv.play(wf, index=index)
         if model is not None:
-            for (_, a, b), p in zip(wf.events[1:], wf.positions[1:]):
+            # every event, the first included: it holds the present A/B (no step) but sets Z to
+            # zfun of the start position, which the driver plays too (an index edge there)
+            for (_, a, b), p in zip(wf.events, wf.positions):
                 model.sample((a, b), zfun(p) if zfun else 0)
         self.pos = wf.positions[-1]
         await self.settle()
