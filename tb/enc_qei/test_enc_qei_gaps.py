@@ -17,7 +17,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from harness import run
 from hedsmodel import QUAD, random_walk, walk, with_glitches
 from qei_model import QeiModel
-from qei_tb import PERIOD_PS, T_NS, event_bits, extra_sources, pack, regmap, size_mask
+from qei_tb import (PERIOD_PS, T_NS, event_bits, extra_sources, pack, play_clocks, regmap, size_mask,
+                    step_clocks)
 from test_enc_qei import begin, durations
 
 
@@ -440,6 +441,172 @@ async def bounded_range_fast(dut):
         await env.check(model, f"{mode} CEILING {ceiling:#x} PRESET {preset:#x} fast")
         await bus.wr("INDEX_CTRL", 0)
         model.idx_action = "none"
+
+
+# ---- steps in consecutive clocks, at loads and wraps -------------------------------------------------
+# The count keeps at-CEILING and at-zero flags in registers, computed from the next count's
+# candidates (Fmax): a step in the clock right after another step, a wrap or a load uses a flag that
+# was computed in the clock before, not recomputed from a quiet count. These tests put steps in
+# consecutive clocks (FILTER_LEN 1, one level per clock, qei_tb.play_clocks) right at those points.
+# (Ceilings: 0, small ones, a high half that equals the count's with bit 27 set, bit 31 and bit 63.)
+def _ceilings(count_w, zero=True):
+    c = ([0] if zero else []) + [0x25, 0x0800_0040, 0x8000_8021]
+    if count_w > 32:
+        c += [0x8000_0800_0000_0021]
+    return c
+
+
+def _near(values, lo, hi):
+    return sorted({v for v in values if lo <= v <= hi})
+
+
+# per clock: +1, -1 or 0 (no step); pairs in consecutive clocks, each way, with quiet clocks between
+BURST = (-1, +1, 0, 0, +1, +1, 0, 0, -1, -1, 0, 0, +1, -1, 0, 0, -1, +1, +1, 0, 0, +1, -1, -1, 0)
+
+
+@cocotb.test()
+async def steps_in_consecutive_clocks(dut):
+    """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
+    and just below CEILING, at 0 and at the top, steps in consecutive clocks both ways (an up step
+    right after a down step, a wrap right after a wrap, ...): COUNT, EVENTS and STATUS.STOPPED
+    equal the model's after each burst."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("modulo", "limit", "non_recycle", "free"):
+        for ceiling in (_ceilings(env.count_w) if mode != "free" else [top]):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            starts = _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, top], 0, top)
+            for start in starts:
+                await bus.set_count(start)
+                model.write_count(start)
+                await env.settle(4)
+                await play_clocks(env, model, step_clocks(env.pos, BURST))
+                await env.settle(4)
+                what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks"
+                await env.check(model, what)
+                stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb.test()
+async def index_at_steps(dut):
+    """An index preset in the clock right before steps in consecutive clocks (PRESET at, just above
+    and just below CEILING, also in another 16-bit slice), and an index latch in the very clock of
+    a wrap (down from 0 to CEILING, up from CEILING to 0) or of a step: COUNT, EVENTS and
+    INDEX_LATCH equal the model's, in every bounded range."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for action in ("preset", "latch"):
+        for mode in ("modulo", "limit", "non_recycle"):
+            for ceiling in _ceilings(env.count_w, zero=False):
+                await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
+                model.idx_action, model.idx_oneshot, model.idx_edge = action, False, "rising"
+                model.idx_gate, model.idx_arm = None, True
+                lo16 = ceiling & ~0xFFFF  # the same upper slices, a lower low slice
+                values = _near([ceiling - 1, ceiling, ceiling + 1, 0] + ([lo16 | 0x10] if action ==
+                               "preset" else []), 0, top)
+                for value in values:
+                    if action == "preset":
+                        await bus.set64("PRESET", value)
+                        model.preset = value
+                        await bus.set_count(ceiling // 2)
+                        model.write_count(ceiling // 2)
+                    else:
+                        await bus.set_count(value)
+                        model.write_count(value)
+                    await env.settle(4)
+                    # Z rises alone, then steps from the next clock on; then Z rises with a step
+                    for steps, z in (((0, +1, +1, -1, 0), (1, 1, 0, 0, 0)),
+                                     ((0, -1, -1, +1, 0), (1, 1, 0, 0, 0)),
+                                     ((-1, +1, 0), (1, 0, 0)), ((+1, -1, 0), (1, 0, 0)),
+                                     ((-1, -1, 0), (1, 0, 0)), ((+1, +1, 0), (1, 0, 0))):
+                        await play_clocks(env, model, step_clocks(env.pos, steps, z))
+                    await env.settle(4)
+                    what = f"{mode} CEILING {ceiling:#x} {action} at {value:#x}"
+                    await env.check(model, what)
+                    if action == "latch":
+                        latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+                        assert latch == model.idx_latch, \
+                            f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
+                await bus.wr("INDEX_CTRL", 0)
+                model.idx_action = "none"
+
+
+@cocotb.test()
+async def unit_timer_prescaled(dut):
+    """The unit timer at PRESCALE 2 .. 5 (ticks 3 .. 6 clocks apart: clocks without a tick between
+    the ticks): SNAP_PERIOD = P gives a SNAP_READY exactly P x (PRESCALE + 1) clocks after the
+    previous one, and SNAP_TIME values exactly P ticks apart."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    await bus.wr("IRQ_EN", event_bits("SNAP_READY"))
+    for pre, p in ((2, 0x2D), (3, 0x24), (3, 0x28), (4, 0x1E), (5, 0x1C), (3, 0x2C), (5, 0x25)):
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("SNAP_PERIOD", p)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        seen = []
+        for k in range(4):
+            await bus.events()  # clear SNAP_READY; the next one raises irq
+            n = 0
+            while dut.irq.value == 0:
+                await RisingEdge(dut.clk)
+                n += 1
+                assert n < 4 * p * (pre + 1) + 100, f"PRESCALE {pre} SNAP_PERIOD {p}: no snapshot"
+            at = round(get_sim_time("ns") / T_NS)
+            t = await bus.rd("SNAP_TIME")
+            seen.append((at, t))
+        for (c0, t0), (c1, t1) in zip(seen[1:], seen[2:]):  # (the first one: timer phase unknown)
+            assert c1 - c0 == p * (pre + 1), \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: snapshots {c1 - c0} clocks apart, not {p * (pre + 1)}"
+            assert (t1 - t0) & ts_mask == p, \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: SNAP_TIME {t0:#x} then {t1:#x}, not {p} ticks apart"
+        await bus.wr("SNAP_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb.test()
+async def snapshot_deltas_held(dut):
+    """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
+    an odd and an even number of clocks apart, after walks forward and back (positive and negative
+    deltas, EDGE any and A rising): always the applied steps since the previous snapshot, and the
+    count change between the last selected edges of the two snapshots."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for edge in ("any", "a_rising"):
+        await env.setup(model, count=1000, filter_len=1)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        await env.settle(4)
+        last_edge = None  # 4X position of the last selected edge up to the previous snapshot
+        for n in (9, -14, 5, -3, 22, -30):
+            steps = [1 if n > 0 else -1] * abs(n)
+            wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+            await env.play(wf, model)
+            rises = [p for q, p in zip(wf.positions, wf.positions[1:])
+                     if edge == "any" or (QUAD[q % 4][0], QUAD[p % 4][0]) == (0, 1)]
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+            await env.settle(4)
+            for gap in (1, 2, 0):
+                delta = await bus.rd("SNAP_DELTA")
+                edge_delta = await bus.rd("SNAP_EDGE_DELTA")
+                assert delta == n & 0xFFFFFFFF, f"EDGE {edge}: SNAP_DELTA {delta:#x} after {n} steps"
+                if rises and last_edge is not None:
+                    exp = (rises[-1] - last_edge) & 0xFFFFFFFF
+                    assert edge_delta == exp, \
+                        f"EDGE {edge}: SNAP_EDGE_DELTA {edge_delta:#x}, expected {exp:#x} after {n} steps"
+                if gap:
+                    await ClockCycles(dut.clk, gap)
+            if rises:
+                last_edge = rises[-1]
+    await bus.wr("SNAP_CTRL", 0)
 
 
 # ---- register block -----------------------------------------------------------------------------------------
