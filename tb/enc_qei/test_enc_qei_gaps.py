@@ -526,13 +526,15 @@ async def index_at_steps(dut):
                                      ((-1, +1, 0), (1, 0, 0)), ((+1, -1, 0), (1, 0, 0)),
                                      ((-1, -1, 0), (1, 0, 0)), ((+1, +1, 0), (1, 0, 0))):
                         await play_clocks(env, model, step_clocks(env.pos, steps, z))
+                        what = f"{mode} CEILING {ceiling:#x} {action} at {value:#x}, steps {steps}"
+                        if action == "latch":  # each latch (the next Z edge overwrites it)
+                            await env.settle(4)
+                            latch = (await bus.rd("INDEX_LATCH_LO")
+                                     | await bus.rd("INDEX_LATCH_HI") << 32)
+                            assert latch == model.idx_latch, \
+                                f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
                     await env.settle(4)
-                    what = f"{mode} CEILING {ceiling:#x} {action} at {value:#x}"
                     await env.check(model, what)
-                    if action == "latch":
-                        latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
-                        assert latch == model.idx_latch, \
-                            f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
                 await bus.wr("INDEX_CTRL", 0)
                 model.idx_action = "none"
 
@@ -607,6 +609,26 @@ async def snapshot_deltas_held(dut):
             if rises:
                 last_edge = rises[-1]
     await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
+async def period_above_2k_ticks(dut):
+    """PERIOD of edge intervals of 2,652 ticks (bits 2 .. 11 in the tick counter and PERIOD; the
+    other tests measure 765 ticks at most, or the 2^16 overflow at TS_W 16): exact, and held
+    (read an odd and an even number of clocks apart)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    d = 0x0A5C
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    for gap in (1, 2, 0):  # held: the same value at reads an odd and an even clock apart
+        period = await bus.rd("PERIOD")
+        assert period == d, f"PERIOD {period:#x}, expected {d:#x}"
+        if gap:
+            await ClockCycles(dut.clk, gap)
+    await bus.wr("PERIOD_CTRL", 0)
 
 
 # ---- register block -----------------------------------------------------------------------------------------
