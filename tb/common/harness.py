@@ -162,7 +162,9 @@ def run(
         if sim != "icarus":
             raise SystemExit("mutation mode (MUT_LOOP_IDS) runs on Icarus only")
         ctl = build_dir / "mut_ctl.v"
-        ctl.write_text("module mut_ctl;\n  reg [15:0] sel;\n  initial sel = 16'd0;\nendmodule\n")
+        # no initial value: an `initial` (or an initializer) runs at time 0 after cocotb's first
+        # test has set sel, and would undo it (mut_loop sets sel before every test)
+        ctl.write_text("module mut_ctl;\n  reg [15:0] sel;\nendmodule\n")
         sources.append(ctl)
         build_args += ["-s", "mut_ctl"]
         verdicts = Path(os.environ.get("MUT_LOOP_DIR") or build_dir) / f"{name}.json"
