@@ -46,10 +46,13 @@ MODULE = os.environ.get("MUT_LOOP_MODULE", "")
 IDS = [int(x) for x in os.environ.get("MUT_LOOP_IDS", "").split(",") if x.strip()]
 RESULTS = os.environ.get("MUT_LOOP_RESULTS", "")
 TESTCASE = [s for s in os.environ.get("MUT_LOOP_TESTCASE", "").split(",") if s]
-BASELINE = os.environ.get("MUT_LOOP_BASELINE", "1") != "0"
-# a mutant still alive after CAP x the unmutated run's time stops here as "capped" (scripts/mutate.py
-# checks it for equivalence first, then resumes it: RESUME = {mutant: [tests it passed]})
-CAP = float(os.environ.get("MUT_LOOP_CAP") or 0)
+# "1": mutant 0 runs every test first; "lazy": a test is run on mutant 0 the first time it kills a
+# mutant (only tests that kill need to be shown to pass on the unmutated design); "0": neither
+BASELINE = os.environ.get("MUT_LOOP_BASELINE", "1")
+LAZY = BASELINE == "lazy"
+# a mutant still alive after CAP_S seconds stops here as "capped" (scripts/mutate.py checks it for
+# equivalence first, then resumes it: RESUME = {mutant: [tests it passed]})
+CAP_S = float(os.environ.get("MUT_LOOP_CAP_S") or 0)
 RESUME = (json.loads(open(os.environ["MUT_LOOP_RESUME"]).read())
           if os.environ.get("MUT_LOOP_RESUME") else {})
 
@@ -81,7 +84,9 @@ def selected() -> list[Test]:
 class Loop:
     def __init__(self, tests: list[Test]):
         self.tests = tests
-        self.queue = ([0] if BASELINE else []) + [k for k in IDS if k != 0]
+        self.queue = ([0] if BASELINE == "1" else []) + [k for k in IDS if k != 0]
+        self.verify_q: list[Test] = []  # LAZY: killing tests still to run on mutant 0
+        self.verified: set[str] = set()
         self.kills = {t.fullname: 0 for t in tests}
         self.cost = {t.fullname: 0.0 for t in tests}  # baseline wall seconds
         self.sim_ns = {t.fullname: 0.0 for t in tests}  # baseline simulated ns
@@ -102,6 +107,11 @@ class Loop:
         while True:
             if self.broken:
                 return None
+            if self.cur_k is None and self.verify_q:  # LAZY: a killer on the unmutated design
+                self.cur_k = 0
+                self.k_t0, self.k_wall = time.monotonic(), time.time()
+                self.results.setdefault(0, {"result": "passed", "tests": 0, "seconds": 0.0})
+                return 0, self.verify_q[0]
             if self.cur_k is None:
                 if not self.queue:
                     return None
@@ -123,6 +133,8 @@ class Loop:
         if k == 0 and result != "passed":
             self.broken = f"the unmutated design (mutant 0) fails {test}"
         if k and result in ("killed", "timeout"):
+            if LAZY and test not in self.verified and all(t.fullname != test for t in self.verify_q):
+                self.verify_q += [t for t in self.tests if t.fullname == test]
             self.kills[test] += 1
             killers = sorted((t for t in self.tests if self.kills[t.fullname]),
                              key=lambda t: -self.kills[t.fullname] / max(self.cost[t.fullname], 0.02))
@@ -135,8 +147,8 @@ class Loop:
             return t.timeout
         if os.environ.get("MUT_LOOP_TIMEOUT_NS"):
             return (float(os.environ["MUT_LOOP_TIMEOUT_NS"]), "ns")
-        if self.cur_k == 0:
-            return None
+        if self.cur_k == 0 or not self.sim_ns[t.fullname]:
+            return None  # (the wall-clock watchdog of scripts/mutate.py still applies)
         return (round(10 * self.sim_ns[t.fullname] + 1_000_000), "ns")
 
     # ---- cocotb's verdict ---------------------------------------------------------------------
@@ -146,16 +158,27 @@ class Loop:
             return
         self.running = None
         self.done_tests.append(t.fullname)
-        if k == 0:
+        if k == 0 or (outcome != "failed" and not self.cost[t.fullname]):
             self.cost[t.fullname] = time.monotonic() - self.t0
             self.sim_ns[t.fullname] = get_sim_time("ns") - self.sim0
+        if k == 0 and LAZY:  # one killing test on the unmutated design
+            r0 = self.results[0]
+            self.verify_q.pop(0)
+            self.cur_k = None
+            r0["seconds"] = round(r0["seconds"] + time.monotonic() - self.t0, 2)
+            r0["tests"] += 1
+            if outcome == "failed":
+                r0["result"] = "failed"
+                self.broken = f"the unmutated design (mutant 0) fails {t.fullname}"
+            self.verified.add(t.fullname)
+            self.write()
+            return
         self.results[k]["tests"] = len(self.done_tests)
         if outcome == "failed":
             self.done_tests.pop()
             timeout = type(exc).__name__ == "SimTimeoutError" if exc is not None else False
             self.finish(k, "timeout" if timeout else "killed", t.fullname)
-        elif (k and CAP and self.results.get(0, {}).get("result") == "passed"
-              and time.monotonic() - self.k_t0 > CAP * self.results[0]["seconds"] >= 8
+        elif (k and CAP_S and time.monotonic() - self.k_t0 > CAP_S
               and len(self.done_tests) < len(self.tests)):
             self.finish(k, "capped", "")
         else:
