@@ -952,6 +952,8 @@ def main() -> int:
         return report_again(args)
     if args.jobs < 1:
         ap.error("--jobs must be >= 1")
+    if args.n is not None and not 1 <= args.n < 1 << SEL_W:
+        ap.error(f"-n must be 1 .. {(1 << SEL_W) - 1}")
 
     only = [m for m in args.only.split(",") if m]
     for m in only:
