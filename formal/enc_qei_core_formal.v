@@ -20,6 +20,7 @@
 //                       the index hit of sample s (ev_index); the range applies the step: the
 //                       count, STOPPED, applied_up/dn, overflow/underflow are those of this clock
 //   clock t + 3         count shows it; ev_cmp / cmp_out one clock later if it equals COMPARE
+// RANGE and the index controls (INDEX_CTRL: ACTION, ARM, ONESHOT) act one clock after they change.
 // CEILING: the range uses the ceiling input as of two clocks earlier (a CEILING write acts two
 // clocks after it; the core keeps a pipeline of it so that count >= CEILING is a flag register).
 // COUNT_LO writes load the count one clock after their strobe (the value: the written low word
@@ -176,6 +177,17 @@ module enc_qei_core_formal #(
 
   always @(*) begin
     if (!f_past_valid) assume (rst);
+  end
+
+  // RANGE and INDEX_CTRL act one clock after they change (the core registers them: its range and
+  // index decisions are flag registers, for Fmax): the model uses them as of the clock before.
+  reg [1:0] f_range = 2'd0, f_act = 2'd0;
+  reg       f_arm = 1'b0, f_oneshot = 1'b0;
+  always @(posedge clk) begin
+    f_range   <= range;
+    f_act     <= idx_action;
+    f_arm     <= idx_arm;
+    f_oneshot <= idx_oneshot;
   end
 
 `ifdef X4FREE
@@ -337,7 +349,7 @@ module enc_qei_core_formal #(
     f_took    = 1'b0;
     f_stop_d  = f_stopped;
     if (f_su) begin
-      case (range)
+      case (f_range)
         R_FREE: begin
           f_stepped = f_count + ONE;
           f_ovf = (f_count == ALL1);
@@ -349,16 +361,16 @@ module enc_qei_core_formal #(
           f_took = 1'b1;
         end
         default: begin  // limit, non_recycle (while not stopped)
-          if (range == R_LIMIT || !f_stopped) begin
+          if (f_range == R_LIMIT || !f_stopped) begin
             f_stepped = f_at_ceil ? f_count : f_count + ONE;
             f_ovf = f_at_ceil;
             f_took = ~f_at_ceil;
-            if (range == R_NON_RECYCLE) f_stop_d = f_at_ceil;
+            if (f_range == R_NON_RECYCLE) f_stop_d = f_at_ceil;
           end
         end
       endcase
     end else if (f_sd) begin
-      case (range)
+      case (f_range)
         R_FREE: begin
           f_stepped = f_count - ONE;
           f_unf = f_at_zero;
@@ -370,11 +382,11 @@ module enc_qei_core_formal #(
           f_took = 1'b1;
         end
         default: begin
-          if (range == R_LIMIT || !f_stopped) begin
+          if (f_range == R_LIMIT || !f_stopped) begin
             f_stepped = f_at_zero ? f_count : f_count - ONE;
             f_unf = f_at_zero;
             f_took = ~f_at_zero;
-            if (range == R_NON_RECYCLE) f_stop_d = f_at_zero;
+            if (f_range == R_NON_RECYCLE) f_stop_d = f_at_zero;
           end
         end
       endcase
@@ -382,8 +394,8 @@ module enc_qei_core_formal #(
     if (f_lw_q) f_stop_d = 1'b0;  // a COUNT write releases non_recycle
   end
 
-  wire               f_armed = idx_arm & (idx_action != 2'd0);
-  wire               f_preset = f_ihit & f_armed & (idx_action == I_PRESET);
+  wire               f_armed = f_arm & (f_act != 2'd0);
+  wire               f_preset = f_ihit & f_armed & (f_act == I_PRESET);
   wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};  // the value a COUNT_LO write loads
   wire [COUNT_W-1:0] f_wr = f_wr64[COUNT_W-1:0];
   // a COUNT_LO write loads the count one clock after its strobe (f_lw_q, f_wr_q), an index preset
@@ -426,7 +438,7 @@ module enc_qei_core_formal #(
   reg  f_pprev = 1'b0, f_pok = 1'b0, f_phit = 1'b0;
   reg  [COUNT_W-1:0] f_idx_latch = {COUNT_W{1'b0}}, f_probe_latch = {COUNT_W{1'b0}};
   reg  [TS_W-1:0]    f_probe_time = {TS_W{1'b0}};
-  wire f_ilatch = f_ihit & f_armed & (idx_action == 2'd2);
+  wire f_ilatch = f_ihit & f_armed & (f_act == 2'd2);
   always @(posedge clk) begin
     if (rst | ~valid) begin
       f_pprev <= 1'b0;
@@ -462,7 +474,7 @@ module enc_qei_core_formal #(
       assert (edge_any == f2_edge && edge_a_rise == f2_arise_edge);
       assert (ev_index == f_ihit);
       assert (idx_armed == f_armed);
-      assert (idx_disarm == (f_ihit & f_armed & idx_oneshot));
+      assert (idx_disarm == (f_ihit & f_armed & f_oneshot));
 `ifndef PIPE_ONLY
       assert (count == f_count);
       assert (stopped == f_stopped);
@@ -498,28 +510,28 @@ module enc_qei_core_formal #(
     if (f_past_valid && !$past(rst)) begin
       // an applied step moves the count by exactly one, in the range
       if ($past(applied_up))
-        assert (count == (($past(range) == R_MODULO && $past(count) >= $past(f_ceil)) ? ZERO :
+        assert (count == (($past(f_range) == R_MODULO && $past(count) >= $past(f_ceil)) ? ZERO :
                           $past(count) + ONE));
       if ($past(applied_dn))
-        assert (count == (($past(range) == R_MODULO && $past(count) == ZERO) ? $past(f_ceil) :
+        assert (count == (($past(f_range) == R_MODULO && $past(count) == ZERO) ? $past(f_ceil) :
                           $past(count) - ONE));
       assert (!$past(applied_up && applied_dn));
       // the count changes only by a step, a COUNT_LO write or an index preset
       if (!$past(applied_up || applied_dn || f_lw_q || f_preset)) assert (count == $past(count));
       if ($past(f_lw_q)) assert (count == $past(f_wr_q));
       // a bounded range is never left by counting
-      if ($past(range) != R_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
+      if ($past(f_range) != R_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
         assert (count <= $past(f_ceil));
       // limit / non_recycle: never past the bounds, the stop raises the event and is no step
-      if ($past(range) == R_LIMIT || $past(range) == R_NON_RECYCLE) begin
+      if ($past(f_range) == R_LIMIT || $past(f_range) == R_NON_RECYCLE) begin
         if ($past(step_up) && $past(count) >= $past(f_ceil))
-          assert (!$past(applied_up) && $past(ev_overflow) == ($past(range) == R_LIMIT || !$past(stopped)));
+          assert (!$past(applied_up) && $past(ev_overflow) == ($past(f_range) == R_LIMIT || !$past(stopped)));
         if ($past(step_dn) && !$past(step_up) && $past(count) == ZERO)
-          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(range) == R_LIMIT || !$past(stopped)));
+          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(f_range) == R_LIMIT || !$past(stopped)));
       end
       // non_recycle: stopped stays stopped (and the count still) until a COUNT_LO write
       if ($past(stopped) && !$past(f_lw_q)) assert (stopped);
-      if ($past(stopped) && $past(range) == R_NON_RECYCLE && !$past(f_load))
+      if ($past(stopped) && $past(f_range) == R_NON_RECYCLE && !$past(f_load))
         assert (count == $past(count) && !$past(applied_up || applied_dn));
       if ($past(f_lw_q)) assert (!stopped);
     end
@@ -572,16 +584,16 @@ module enc_qei_core_formal #(
   // ---- covers: every property's situation is reached ---------------------------------------------
   always @(posedge clk) begin
     if (f_past_valid && !rst) begin
-      cover (func == F_X4 && range == R_FREE && applied_up && count == ONE);
-      cover (func == F_X4 && range == R_FREE && applied_dn && count == ZERO);
-      cover (range == R_FREE && ev_overflow && applied_up);
-      cover (range == R_FREE && ev_underflow && applied_dn);
-      cover (range == R_MODULO && ev_overflow && applied_up && count != ZERO);
-      cover (range == R_MODULO && ev_underflow && applied_dn && f_ceil != ALL1);
-      cover (range == R_LIMIT && ev_overflow && step_up && count == f_ceil && f_ceil != ALL1);
-      cover (range == R_LIMIT && ev_underflow && step_dn);
-      cover (range == R_NON_RECYCLE && ev_overflow && !stopped && f_ceil != ALL1);
-      cover (range == R_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
+      cover (func == F_X4 && f_range == R_FREE && applied_up && count == ONE);
+      cover (func == F_X4 && f_range == R_FREE && applied_dn && count == ZERO);
+      cover (f_range == R_FREE && ev_overflow && applied_up);
+      cover (f_range == R_FREE && ev_underflow && applied_dn);
+      cover (f_range == R_MODULO && ev_overflow && applied_up && count != ZERO);
+      cover (f_range == R_MODULO && ev_underflow && applied_dn && f_ceil != ALL1);
+      cover (f_range == R_LIMIT && ev_overflow && step_up && count == f_ceil && f_ceil != ALL1);
+      cover (f_range == R_LIMIT && ev_underflow && step_dn);
+      cover (f_range == R_NON_RECYCLE && ev_overflow && !stopped && f_ceil != ALL1);
+      cover (f_range == R_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
       cover ($past(stopped) && f_lw_q && !rst);               // released by a COUNT_LO write
       cover (ev_qerr && func == F_X4);
       cover (ev_dir_change && step_dn);

@@ -16,10 +16,12 @@
 // written). Every decoder output has latency 1 from its sample and the count step one more
 // register; the index edge detector is delayed the same, so an index acts in the clock of the
 // transition it sees.
-// For Fmax, the comparisons with CEILING and the zero tests of the loads are flag registers:
-// CEILING acts two clocks after it changes, a COUNT_LO write loads the count one clock after
-// its strobe (with the COUNT_HI word staged as of the strobe), and an index preset loads PRESET
-// as it was one clock earlier. A bus access takes longer than these delays: software cannot tell.
+// For Fmax, the range's decisions (wrap, stop, hold at CEILING or 0), the zero test and the
+// loads are flag registers, set a clock ahead from the next count's candidates: CEILING acts two
+// clocks after it changes, RANGE and INDEX_CTRL one clock after, a COUNT_LO write loads the count
+// one clock after its strobe (with the COUNT_HI word staged as of the strobe), and an index
+// preset loads PRESET as it was one clock earlier. A bus access takes longer than these delays:
+// software cannot tell.
 `default_nettype none
 
 module enc_qei_core #(
@@ -243,11 +245,29 @@ module enc_qei_core #(
   assign edge_a_rise = edge_a_rise_q;
   assign ev_qerr     = quad & x4_err;
 
+  // ---- configuration, one clock late (Fmax) ---------------------------------------------------------
+  // RANGE and INDEX_CTRL act one clock after they change, so that the decisions of the range
+  // (wrap, stop, hold) and of the index preset can be flag registers below. Not reset: a pure
+  // delay of the registers (which rst clears).
+  reg [1:0] range_q;
+  reg       idx_arm_q;
+  reg [1:0] idx_action_q;
+  reg       idx_oneshot_q;
+
+  always @(posedge clk) begin
+    range_q       <= range;
+    idx_arm_q     <= idx_arm;
+    idx_action_q  <= idx_action;
+    idx_oneshot_q <= idx_oneshot;
+  end
+
+  wire r_free   = (range_q == R_FREE);
+  wire r_nr     = (range_q == R_NON_RECYCLE);
+
   // ---- range ---------------------------------------------------------------------------------------
   reg  [COUNT_W-1:0] count_q;
   reg  [COUNT_W-1:0] count_d;
   reg                stopped_q;
-  reg                stopped_d;
   reg  [31:0]        hi_stage_q;
   reg  [31:0]        hi_latch_q;
 
@@ -274,90 +294,67 @@ module enc_qei_core #(
     end
   endfunction
 
+  // a > K for COUNT_W-bit values, given kn = ~K (a register: no inverters in front of the carry
+  // chains): the carry out of a + ~K. 16-bit slices side by side (short chains), each upper slice
+  // as > (carry in 0) and >= (carry in 1: the {x, 1} + {y, 1} form), chosen by the slice below.
+  function gt_n;
+    input [COUNT_W-1:0] a;
+    input [COUNT_W-1:0] kn;
+    reg   [63:0] a64, k64;
+    // verilator lint_off UNUSEDSIGNAL
+    reg   [16:0] gt_s;  // (only the carry out, bit 16 / 17, is used)
+    reg   [17:0] ge_s;
+    // verilator lint_on UNUSEDSIGNAL
+    integer      k;
+    begin
+      a64              = zext64(a);
+      k64              = {64{1'b1}};  // ~K: ones above COUNT_W
+      k64[COUNT_W-1:0] = kn;
+      gt_s = {1'b0, a64[15:0]} + {1'b0, k64[15:0]};
+      gt_n = gt_s[16];
+      for (k = 1; k < NSL; k = k + 1) begin
+        gt_s = {1'b0, a64[16*k +: 16]} + {1'b0, k64[16*k +: 16]};
+        ge_s = {1'b0, a64[16*k +: 16], 1'b1} + {1'b0, k64[16*k +: 16], 1'b1};
+        gt_n = gt_s[16] | (ge_s[17] & gt_n);
+      end
+    end
+  endfunction
+
   // ---- CEILING pipeline (Fmax) ----------------------------------------------------------------------
-  // The count uses CEILING as it was two clocks earlier (ceil_q), so that at_ceil = (count >=
-  // CEILING) can be a flag register (at_ceil_q), set like zero_q from the next count's candidates,
-  // each compared with the next clock's ceiling (ceil_nx_q) by a comparator between registers.
+  // The count uses CEILING as it was two clocks earlier (ceil_q), so that (count >= CEILING) can
+  // be flag registers (up_wrap_q, up_lim_q, up_blk_q below), set like zero_q from the next count's
+  // candidates, each compared with the next clock's ceiling N (kept inverted, as N - 1 and N - 2
+  // as well, for gt_n) by a comparator between registers.
   // Not reset: a pure delay of the CEILING register.
-  reg [COUNT_W-1:0] ceil_nx_q;       // CEILING one clock ago: the ceiling of the next clock
-  reg [COUNT_W-1:0] ceil_nx_m1_q;    // ... minus one
-  reg               ceil_nx_zero_q;  // ... is 0
+  reg [COUNT_W-1:0] ceil_nx_n_q;     // ~N, N = CEILING one clock ago: the ceiling of the next clock
+  reg [COUNT_W-1:0] ceil_nx_m1n_q;   // ~(N - 1)
+  reg [COUNT_W-1:0] ceil_nx_m2n_q;   // ~(N - 2)
+  reg               ceil_nx_zero_q;  // N == 0
+  reg               ceil_nx_le1_q;   // N <= 1
   reg [COUNT_W-1:0] ceil_q;          // CEILING two clocks ago: the ceiling the count uses now
   reg               ceil_zero_q;     // ... is 0
-  reg               ceil_wrap_ge_q;  // ceil_q >= ceil_nx_q (a modulo wrap down to ceil_q)
+  reg               ceil_wrap_ge_q;  // ceil_q >= N (a modulo wrap down to ceil_q)
+  wire [COUNT_W-1:0] ceil_nx = ~ceil_nx_n_q;
 
   always @(posedge clk) begin
-    ceil_nx_q      <= ceiling;
-    ceil_nx_m1_q   <= ceiling - {{(COUNT_W-1){1'b0}}, 1'b1};
+    ceil_nx_n_q    <= ~ceiling;
+    ceil_nx_m1n_q  <= ~(ceiling - {{(COUNT_W-1){1'b0}}, 1'b1});
+    ceil_nx_m2n_q  <= ~(ceiling - {{(COUNT_W-2){1'b0}}, 2'd2});
     ceil_nx_zero_q <= (ceiling == {COUNT_W{1'b0}});
-    ceil_q         <= ceil_nx_q;
+    ceil_nx_le1_q  <= (ceiling[COUNT_W-1:1] == {(COUNT_W-1){1'b0}});
+    ceil_q         <= ceil_nx;
     ceil_zero_q    <= ceil_nx_zero_q;
-    ceil_wrap_ge_q <= ge_w(ceil_nx_q, ceiling);
-  end
-
-  reg  at_ceil_q;  // count_q >= ceil_q
-  wire at_ceil = at_ceil_q;
-
-
-  reg               ovf, unf, took;
-
-  always @(*) begin
-    ovf     = 1'b0;
-    unf     = 1'b0;
-    took    = 1'b0;
-    stopped_d = stopped_q;
-    case (range)
-      R_FREE: begin
-        if (step_up) begin
-          ovf     = at_max;
-          took    = 1'b1;
-        end else if (step_dn) begin
-          unf     = at_zero;
-          took    = 1'b1;
-        end
-      end
-      R_MODULO: begin
-        if (step_up) begin
-          ovf     = at_ceil;
-          took    = 1'b1;
-        end else if (step_dn) begin
-          unf     = at_zero;
-          took    = 1'b1;
-        end
-      end
-      R_LIMIT: begin
-        if (step_up) begin
-          ovf     = at_ceil;
-          took    = ~at_ceil;
-        end else if (step_dn) begin
-          unf     = at_zero;
-          took    = ~at_zero;
-        end
-      end
-      R_NON_RECYCLE: begin
-        if (!stopped_q) begin
-          if (step_up) begin
-            ovf       = at_ceil;
-            took      = ~at_ceil;
-            stopped_d = at_ceil;
-          end else if (step_dn) begin
-            unf       = at_zero;
-            took      = ~at_zero;
-            stopped_d = at_zero;
-          end
-        end
-      end
-    endcase
-    if (wr_q) begin
-      stopped_d = 1'b0;
-    end
+    ceil_wrap_ge_q <= ge_w(ceil_nx, ceiling);
   end
 
   // ---- index ---------------------------------------------------------------------------------------
   // Qualified index: Z and, with the gate, (A, B) = (GATE_A, GATE_B); the chosen edge of it acts.
   wire idx_q      = z_eff & (~idx_gate_en | ((a_eff == idx_gate_a) & (b_eff == idx_gate_b)));
-  wire armed      = idx_arm & (idx_action != 2'd0);
+  wire armed      = idx_arm_q & (idx_action_q != 2'd0);
   reg  idx_prev_q, idx_ok_q, idx_hit1_q, idx_hit_q;
+  // a latch hit, registered with the hit (from INDEX_CTRL as the next clock's idx_*_q show it)
+  reg  lat_hit_q;  // idx_hit_q & armed & ACTION = latch
+  wire idx_hit1_d = idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
 
   always @(posedge clk) begin
     if (rst | ~valid) begin
@@ -365,133 +362,197 @@ module enc_qei_core #(
       idx_ok_q   <= 1'b0;
       idx_hit1_q <= 1'b0;
       idx_hit_q  <= 1'b0;
+      lat_hit_q  <= 1'b0;
     end else begin
       idx_prev_q <= idx_q;
       idx_ok_q   <= 1'b1;
-      idx_hit1_q <= idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+      idx_hit1_q <= idx_hit1_d;
       idx_hit_q  <= idx_hit1_q;  // aligned with the step register above
+      lat_hit_q  <= idx_hit1_q & idx_arm & (idx_action == I_LATCH);
     end
   end
 
-  wire idx_act    = idx_hit_q & armed;
-  wire idx_preset = idx_act & (idx_action == I_PRESET);
-  wire idx_latch_en = idx_act & (idx_action == I_LATCH);
+  wire idx_act = idx_hit_q & armed;
 
-  // ---- count register ----------------------------------------------------------------------------
+  // ---- loads -----------------------------------------------------------------------------------------
   // verilator lint_off UNUSEDSIGNAL
   wire [63:0] wr_value = {hi_stage_q, count_lo_wdata};  // (the bits above COUNT_W are dropped)
   // verilator lint_on UNUSEDSIGNAL
 
-  // COUNT_LO writes and PRESET, registered (Fmax): a COUNT_LO write loads the count one clock
-  // later, and an index preset loads PRESET as it was one clock earlier, so that their
-  // comparisons with the ceiling and their zero tests are flag registers too.
-  reg               wr_q;        // a COUNT_LO write to apply this clock
-  reg [COUNT_W-1:0] wr_val_q;    // ... its value
-  reg               wr_ge_q;     // ... >= ceil_nx_q
-  reg               wr_zero_q;   // ... == 0
-  reg [COUNT_W-1:0] preset_q;    // PRESET one clock ago
-  reg               pre_ge_q;    // ... >= ceil_nx_q
-  reg               pre_zero_q;  // ... == 0
+  // COUNT_LO writes and index presets, registered (Fmax): a COUNT_LO write loads the count one
+  // clock after its strobe, and an index preset loads PRESET as it was one clock earlier; the
+  // value to load, its comparison with the ceiling and its zero test are registers.
+  reg               wr_q;         // a COUNT_LO write to apply this clock
+  reg               load_q;       // a load this clock: a COUNT_LO write or an index preset
+  reg [COUNT_W-1:0] load_val_q;   // ... its value (the write first)
+  reg               load_ge_q;    // ... >= the next clock's ceiling
+  reg               load_zero_q;  // ... == 0
+  wire              load_wr = count_lo_wr;  // the next clock's load is a write
 
   always @(posedge clk) begin
     if (rst) begin
-      wr_q <= 1'b0;
+      wr_q   <= 1'b0;
+      load_q <= 1'b0;
     end else begin
-      wr_q <= count_lo_wr;
+      wr_q   <= count_lo_wr;
+      load_q <= count_lo_wr | (valid & idx_hit1_q & idx_arm & (idx_action == I_PRESET));
     end
   end
 
   always @(posedge clk) begin
-    wr_val_q   <= wr_value[COUNT_W-1:0];
-    wr_ge_q    <= ge_w(wr_value[COUNT_W-1:0], ceiling);
-    wr_zero_q  <= (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}});
-    preset_q   <= preset;
-    pre_ge_q   <= ge_w(preset, ceiling);
-    pre_zero_q <= (preset == {COUNT_W{1'b0}});
+    load_val_q  <= load_wr ? wr_value[COUNT_W-1:0] : preset;
+    load_ge_q   <= load_wr ? ge_w(wr_value[COUNT_W-1:0], ceiling) : ge_w(preset, ceiling);
+    load_zero_q <= load_wr ? (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}}) :
+                             (preset == {COUNT_W{1'b0}});
   end
 
-  wire        load     = wr_q | idx_preset;
+  // ---- range decisions: flag registers (Fmax) ------------------------------------------------------
+  // What an up / down step does this clock, decided from the flags of the clock before (each set
+  // from the next range, STOPPED, at-ceiling and zero values):
+  //   up:   up_wrap    modulo at CEILING -> 0           down: dn_wrap_q  modulo at 0 -> CEILING
+  //         up_lim     limit / non_recycle at CEILING         dn_lim_q   limit / non_recycle at 0
+  //         stop_q     non_recycle stopped: no step           (the same stop_q)
+  //         up_blk     = up_wrap | up_lim | stop_q            dn_blk_q = dn_wrap_q | dn_lim_q | stop_q
+  // A free range blocks nothing (the count wraps by itself; overflow / underflow at the ends).
+  reg [1:0] up_wrap_q, up_lim_q, up_blk_q;  // (each: partial flags, see parts() below)
+  reg       dn_wrap_q, dn_lim_q, dn_blk_q, stop_q;
+  wire      up_wrap = |up_wrap_q;
+  wire      up_lim  = |up_lim_q;
+  wire      up_blk  = stop_q | (|up_blk_q);
 
-  // ---- next count, zero_q and at_ceil_q ---------------------------------------------------------------
-  // The cases of a clock without a load (an index latch stores the count of this case):
-  wire bounded = (range != R_FREE) & ~((range == R_NON_RECYCLE) & stopped_q);
-  wire modulo  = (range == R_MODULO);
-  wire c_stop  = (range == R_NON_RECYCLE) & stopped_q;           // non_recycle stopped: held
-  wire c_ceil  = step_up & bounded & at_ceil;                    // up at CEILING: wrap or hold
-  wire c_up    = ~c_stop & step_up & ~c_ceil;
-  wire c_dn    = ~c_stop & ~step_up & step_dn;
-  wire c_dwrap = c_dn & at_zero & (range != R_FREE);             // down at 0: wrap or hold
-  wire k_inc   = c_up;                                           // count_q + 1
-  wire k_dec   = c_dn & ~c_dwrap;                                // count_q - 1
-  wire k_zero  = c_ceil & modulo;                                // 0
-  wire k_ceil  = c_dwrap & modulo;                               // the ceiling
-  wire k_hold  = ~k_inc & ~k_dec & ~k_zero & ~k_ceil;            // count_q
-  // ... and with the loads (COUNT write first, then an index preset): one-hot selects. (keep:
-  // Yosys leaves them as nets, so that the late signals below are not folded into their logic.)
-  wire s_wr    = wr_q;
-  wire s_pre   = ~wr_q & idx_preset;
-  (* keep *) wire s_inc;
-  assign s_inc  = ~load & k_inc;
-  (* keep *) wire s_dec;
-  assign s_dec  = ~load & k_dec;
-  (* keep *) wire s_zero;
-  assign s_zero = ~load & k_zero;
-  (* keep *) wire s_ceil;
-  assign s_ceil = ~load & k_ceil;
-  (* keep *) wire s_hold;
-  assign s_hold = ~load & k_hold;
+  // The cases of this clock (step_up and step_dn never come together: every count function gives
+  // one or the other, formal/enc_qei_core.sby asserts it):
+  wire u_step  = step_up & ~stop_q;
+  wire d_step  = ~step_up & step_dn & ~stop_q;
+  wire k_inc   = step_up & ~up_blk;                   // count_q + 1
+  wire k_zero  = step_up & up_wrap;                   // 0
+  wire k_dec   = step_dn & ~dn_blk_q;                 // count_q - 1
+  wire k_ceil  = step_dn & dn_wrap_q;                 // the ceiling
+  (* keep *) wire k_move;  // (keep: the adder's select, one LUT before the count / latch)
+  assign k_move = k_inc | k_dec;
+  wire k_hold  = ~k_move & ~k_zero & ~k_ceil;         // count_q
+  // ... and with the loads (a load wins over the step): one-hot selects. (keep: Yosys leaves
+  // s_move as a net, so that the late adder output is not folded into its logic.)
+  (* keep *) wire s_move;
+  assign s_move = ~load_q & k_move;
+  wire s_inc  = ~load_q & k_inc;
+  wire s_dec  = ~load_q & k_dec;
+  wire s_zero = ~load_q & k_zero;
+  wire s_ceil = ~load_q & k_ceil;
+  wire s_hold = ~load_q & k_hold;
 
-  // Every value is an AND-OR of (select & candidate): the selects are early signals, the adders,
+  // events and STOPPED (a load does not hide the step's event)
+  wire ovf       = u_step & (r_free ? at_max : (up_wrap | up_lim));
+  wire unf       = d_step & (r_free ? at_zero : (dn_wrap_q | dn_lim_q));
+  wire stopped_d = ~wr_q & (stopped_q | (r_nr & ((u_step & up_lim) | (d_step & dn_lim_q))));
+
+  // Every value is an AND-OR of (select & candidate): the selects are early signals, the adder,
   // comparators and zero tests of count_q the late ones, which enter the last logic levels only
-  // (Fmax). The next count:
-  wire [COUNT_W-1:0] count_inc = count_q + {{(COUNT_W-1){1'b0}}, 1'b1};
-  wire [COUNT_W-1:0] count_dec = count_q - {{(COUNT_W-1){1'b0}}, 1'b1};
-  wire [COUNT_W-1:0] stepped   =  // the count after this clock's step, before the loads
-      ({COUNT_W{k_inc}} & count_inc) | ({COUNT_W{k_dec}} & count_dec) |
-      ({COUNT_W{k_hold}} & count_q) | ({COUNT_W{k_ceil}} & ceil_q);
+  // (Fmax). The step: one adder, count_q + 1 or count_q - 1 by step_dn (a register).
+  wire [COUNT_W-1:0] count_step;
 
-  (* keep *) wire [COUNT_W-1:0] count_other;  // every case but the adders' (early signals)
-  assign count_other =
-      ({COUNT_W{s_hold}} & count_q) | ({COUNT_W{s_ceil}} & ceil_q) |
-      ({COUNT_W{s_wr}} & wr_val_q) | ({COUNT_W{s_pre}} & preset_q);
+  generate
+    if (COUNT_W > 16) begin : g_step_split
+      // carry select: the low 16 bits' carry out picks the high part with carry in 0 or 1
+      // (two short chains side by side instead of one long one; Fmax)
+      localparam integer HI_W = COUNT_W - 16;
+      wire [16:0]     lo_sum = {1'b0, count_q[15:0]} + {1'b0, {15{step_dn}}, 1'b1};
+      wire [HI_W-1:0] hi     = count_q[COUNT_W-1:16];
+      wire [HI_W-1:0] hi_c0  = hi + {HI_W{step_dn}};
+      // verilator lint_off UNUSEDSIGNAL
+      wire [HI_W:0]   hi_c1x = {hi, 1'b1} + {{HI_W{step_dn}}, 1'b1};  // (hi + ... + 1) << 1 | 0
+      // verilator lint_on UNUSEDSIGNAL
+      assign count_step = {lo_sum[16] ? hi_c1x[HI_W:1] : hi_c0, lo_sum[15:0]};
+    end else begin : g_step
+      assign count_step = count_q + {{(COUNT_W-1){step_dn}}, 1'b1};
+    end
+  endgenerate
+
+  // the count after this clock's step, before the loads: the adder's, or else (early signals)
+  // the ceiling, 0 or the count itself
+  (* keep *) wire [COUNT_W-1:0] stepped_other;
+  assign stepped_other = ({COUNT_W{k_ceil}} & ceil_q) | ({COUNT_W{~k_ceil & ~k_zero}} & count_q);
+  wire [COUNT_W-1:0] stepped = k_move ? count_step : stepped_other;
+
+  // The next count: the adder's, or else a load or stepped_other (early signals; keep: the late
+  // adder output enters the last LUT level only, Fmax)
+  (* keep *) wire [COUNT_W-1:0] count_other;
+  assign count_other = load_q ? load_val_q : stepped_other;
 
   always @(*) begin
-    count_d = ({COUNT_W{s_inc}} & count_inc) | ({COUNT_W{s_dec}} & count_dec) | count_other;
+    count_d = s_move ? count_step : count_other;
   end
 
-  // zero_d = (count_d == 0)
-  wire is_one  = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
-  wire zero_d  = (s_wr & wr_zero_q) | (s_pre & pre_zero_q) |
-                 (s_hold & zero_q) | (s_inc & at_max) | (s_dec & is_one) | s_zero |
-                 (s_ceil & ceil_zero_q);
+  // The next clock's flags, each an AND-OR over the cases of this clock (the select, early; the
+  // case's candidate value of the flag, late), with rst as one more case (count 0, STOPPED 0)
+  // and +1 split by whether it wraps (count_q at the maximum: in the free range only, a bounded
+  // range stops or wraps there first, the maximum being >= every ceiling).
+  // Cases:         7 rst   6 load   5 hold   4 +1   3 +1 wrapping   2 -1   1 ->0   0 ->CEILING
+  wire [7:0] sel = rst ? 8'b1000_0000 :
+                   {1'b0, load_q, s_hold, s_inc & ~at_max, s_inc & at_max, s_dec, s_zero, s_ceil};
+  // zero: count_d == 0
+  wire is_one = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
+  wire [7:0] z_cand = {1'b1, load_zero_q, zero_q, 1'b0, 1'b1, is_one, 1'b1, ceil_zero_q};
+  // at CEILING: count_d >= N, N the next clock's ceiling (ceil_nx); N = 0: every count is >= N.
+  // count_q - 1 from 0 is the maximum, >= every N. (keep: each comparator's candidate is one LUT
+  // after its carry chains, and its flag one LUT later)
+  (* keep *) wire cand_hold;  // count_q >= N
+  assign cand_hold = ceil_nx_zero_q | gt_n(count_q, ceil_nx_m1n_q);
+  (* keep *) wire cand_inc;   // count_q + 1 >= N (no wrap)
+  assign cand_inc = ceil_nx_le1_q | gt_n(count_q, ceil_nx_m2n_q);
+  (* keep *) wire cand_dec;   // count_q - 1 >= N (count_q > 0), or the maximum (count_q = 0)
+  assign cand_dec = at_zero | gt_n(count_q, ceil_nx_n_q);
+  wire [7:0] c_cand = {ceil_nx_zero_q, load_ge_q, cand_hold, cand_inc, ceil_nx_zero_q, cand_dec,
+                       ceil_nx_zero_q, ceil_wrap_ge_q};
+  // The range gates the selects (early), not the flags (late). The at-CEILING flags are each
+  // kept as two partial registers (their OR is the flag), so that a comparator's carry chains
+  // feed two LUT levels only, the candidate and its flag: (Fmax)
+  //   [0] hold | +1 (the late ones)   [1] -1 (late) | the rest (early)
+  function [1:0] parts;
+    input [2:0] late;   // the gated selects of hold, +1 and -1
+    input [7:0] sel_g;  // all selects, gated by the range
+    reg   [7:0] t;
+    begin
+      t        = sel_g & c_cand & 8'b1100_1011;  // the early cases
+      parts[0] = (late[2] & cand_hold) | (late[1] & cand_inc);
+      parts[1] = (late[0] & cand_dec) | (|t);
+    end
+  endfunction
 
-  // at_ceil_d = (count_d >= ceil_nx_q): each candidate compared with the next clock's ceiling N
-  wire ge_hold = ge_w(count_q, ceil_nx_q);                // count_q     >= N
-  wire ge_m1   = ge_w(count_q, ceil_nx_m1_q);             // count_q + 1 >= N (N > 0, no wrap)
-  wire gt_hold = ~ge_w(ceil_nx_q, count_q);               // count_q - 1 >= N (count_q > 0)
-  // count_q + 1 wraps to 0 only from the maximum (then in the free range: a bounded range stops
-  // or wraps there first, the maximum being >= every ceiling); N = 0: every count is >= N.
-  // count_q - 1 from 0 is the maximum, >= every N.
-  wire at_ceil_d = (s_wr & wr_ge_q) | (s_pre & pre_ge_q) | (s_hold & ge_hold) |
-                   (s_inc & (ceil_nx_zero_q | (ge_m1 & ~at_max))) |
-                   (s_dec & (at_zero | gt_hold)) | (s_zero & ceil_nx_zero_q) |
-                   (s_ceil & ceil_wrap_ge_q);
+  wire       stop_n  = ~rst & (range == R_NON_RECYCLE) & stopped_d;
+  wire [7:0] sel_mod = sel & {8{range == R_MODULO}};                            // next: modulo
+  wire [7:0] sel_lim = sel & {8{(range == R_LIMIT) | (range == R_NON_RECYCLE)}}; // limit, n_r
+  wire [7:0] sel_bnd = sel & {8{range != R_FREE}};                              // bounded
+  // (keep: the late candidates' selects are nets, so that each partial flag is one LUT)
+  (* keep *) wire [2:0] late_mod;
+  assign late_mod = {sel_mod[5], sel_mod[4], sel_mod[2]};
+  (* keep *) wire [2:0] late_lim;
+  assign late_lim = {sel_lim[5], sel_lim[4], sel_lim[2]};
+  (* keep *) wire [2:0] late_bnd;
+  assign late_bnd = {sel_bnd[5], sel_bnd[4], sel_bnd[2]};
+
+  always @(posedge clk) begin
+    zero_q    <= |(sel & z_cand);
+    up_wrap_q <= parts(late_mod, sel_mod);
+    up_lim_q  <= parts(late_lim, sel_lim);
+    up_blk_q  <= parts(late_bnd, sel_bnd);
+    dn_wrap_q <= |(sel_mod & z_cand);
+    dn_lim_q  <= |(sel_lim & z_cand);
+    dn_blk_q  <= stop_n | (|(sel_bnd & z_cand));
+    stop_q    <= stop_n;
+  end
 
   reg upd_q;  // the count changed (step or load) at the last clock edge
 
   always @(posedge clk) begin
     if (rst) begin
       count_q   <= {COUNT_W{1'b0}};
-      zero_q    <= 1'b1;
-      at_ceil_q <= ceil_nx_zero_q;
       stopped_q <= 1'b0;
       upd_q     <= 1'b0;
     end else begin
       count_q   <= count_d;
-      zero_q    <= zero_d;
-      at_ceil_q <= at_ceil_d;
       stopped_q <= stopped_d;
-      upd_q     <= load | took;
+      upd_q     <= ~s_hold;
     end
   end
 
@@ -553,7 +614,7 @@ module enc_qei_core #(
       probe_latch_q <= {COUNT_W{1'b0}};
       probe_time_q  <= {TS_W{1'b0}};
     end else begin
-      if (idx_latch_en) begin
+      if (lat_hit_q) begin
         idx_latch_q <= stepped;
       end
       if (probe_hit_q) begin
@@ -582,10 +643,10 @@ module enc_qei_core #(
   assign dir          = dir_q;
   assign idx_armed    = armed;
   assign stopped      = stopped_q;
-  assign idx_disarm   = idx_act & idx_oneshot;
+  assign idx_disarm   = idx_act & idx_oneshot_q;
   assign probe_disarm = probe_hit_q & probe_once;
-  assign applied_up   = took & step_up & ~load;
-  assign applied_dn   = took & step_dn & ~load;
+  assign applied_up   = s_inc | s_zero;
+  assign applied_dn   = s_dec | s_ceil;
   assign ev_overflow  = ovf;
   assign ev_underflow = unf;
   assign ev_index     = idx_hit_q;
@@ -601,30 +662,54 @@ module enc_qei_core #(
   initial zero_q = 1'b1;
   always @(*) assert (zero_q == (count_q == {COUNT_W{1'b0}}));
   // ... and the CEILING pipeline's flags agree with its values (initial values: CEILING 0)
-  initial ceil_nx_q = {COUNT_W{1'b0}};
-  initial ceil_nx_m1_q = {COUNT_W{1'b1}};
+  initial ceil_nx_n_q = {COUNT_W{1'b1}};
+  initial ceil_nx_m1n_q = {COUNT_W{1'b0}};
+  initial ceil_nx_m2n_q = {{(COUNT_W-1){1'b0}}, 1'b1};
+  initial ceil_nx_le1_q = 1'b1;
   initial ceil_nx_zero_q = 1'b1;
   initial ceil_q = {COUNT_W{1'b0}};
   initial ceil_zero_q = 1'b1;
   initial ceil_wrap_ge_q = 1'b1;
-  initial at_ceil_q = 1'b1;
   initial wr_q = 1'b0;
-  initial wr_val_q = {COUNT_W{1'b0}};
-  initial wr_ge_q = 1'b1;
-  initial wr_zero_q = 1'b1;
-  initial preset_q = {COUNT_W{1'b0}};
-  initial pre_ge_q = 1'b1;
-  initial pre_zero_q = 1'b1;
+  initial load_q = 1'b0;
+  initial load_val_q = {COUNT_W{1'b0}};
+  initial load_ge_q = 1'b1;
+  initial load_zero_q = 1'b1;
+  // ... the configuration delay and the range / index flags (initial: free range, not stopped,
+  // no index hit)
+  initial range_q = R_FREE;
+  initial idx_arm_q = 1'b0;
+  initial idx_action_q = 2'd0;
+  initial idx_oneshot_q = 1'b0;
+  initial stopped_q = 1'b0;
+  initial idx_hit_q = 1'b0;
+  initial lat_hit_q = 1'b0;
+  initial up_wrap_q = 2'd0;
+  initial up_lim_q = 2'd0;
+  initial up_blk_q = 2'd0;
+  initial dn_wrap_q = 1'b0;
+  initial dn_lim_q = 1'b0;
+  initial dn_blk_q = 1'b0;
+  initial stop_q = 1'b0;
+  wire f_at_ceil = (count_q >= ceil_q);
   always @(*) begin
-    assert (ceil_nx_m1_q == ceil_nx_q - {{(COUNT_W-1){1'b0}}, 1'b1});
-    assert (ceil_nx_zero_q == (ceil_nx_q == {COUNT_W{1'b0}}));
+    assert (ceil_nx_m1n_q == ~(ceil_nx - {{(COUNT_W-1){1'b0}}, 1'b1}));
+    assert (ceil_nx_m2n_q == ~(ceil_nx - {{(COUNT_W-2){1'b0}}, 2'd2}));
+    assert (ceil_nx_zero_q == (ceil_nx == {COUNT_W{1'b0}}));
+    assert (ceil_nx_le1_q == (ceil_nx <= {{(COUNT_W-1){1'b0}}, 1'b1}));
     assert (ceil_zero_q == (ceil_q == {COUNT_W{1'b0}}));
-    assert (ceil_wrap_ge_q == (ceil_q >= ceil_nx_q));
-    assert (at_ceil_q == (count_q >= ceil_q));
-    assert (wr_ge_q == (wr_val_q >= ceil_nx_q));
-    assert (wr_zero_q == (wr_val_q == {COUNT_W{1'b0}}));
-    assert (pre_ge_q == (preset_q >= ceil_nx_q));
-    assert (pre_zero_q == (preset_q == {COUNT_W{1'b0}}));
+    assert (ceil_wrap_ge_q == (ceil_q >= ceil_nx));
+    assert (load_ge_q == (load_val_q >= ceil_nx));
+    assert (load_zero_q == (load_val_q == {COUNT_W{1'b0}}));
+    assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == I_PRESET))));
+    assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == I_LATCH)));
+    assert (stop_q == (r_nr & stopped_q));
+    assert (up_wrap == ((range_q == R_MODULO) & f_at_ceil));
+    assert (up_lim == (((range_q == R_LIMIT) | r_nr) & f_at_ceil));
+    assert (up_blk == (stop_q | (~r_free & f_at_ceil)));
+    assert (dn_wrap_q == ((range_q == R_MODULO) & zero_q));
+    assert (dn_lim_q == (((range_q == R_LIMIT) | r_nr) & zero_q));
+    assert (dn_blk_q == (stop_q | (~r_free & zero_q)));
   end
 `endif
 
