@@ -122,7 +122,9 @@ QEI_ALL = _qei(
     G + "bounded_range_fast",
     "heds_unit_profile", G + "prescaler_long", G + "error_counters_wide", "period_capture",
     G + "unit_timer_period", "func_walks", G + "steps_in_consecutive_clocks", G + "index_at_steps",
-    G + "unit_timer_prescaled", G + "snapshot_deltas_held", G + "period_above_2k_ticks")
+    G + "unit_timer_prescaled", G + "snapshot_deltas_held", G + "period_above_2k_ticks",
+    G + "step_pairs_at_bounds", G + "steps_at_patterned_ceilings", G + "free_range_ignores_ceiling",
+    G + "index_gate_each_state")
 
 
 def qei_first(*names: str) -> list[str]:
@@ -147,7 +149,8 @@ QEI_ORDER = {
         "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
         "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",
         "range_modes", "index", "ceiling_wide", "bounded_range_fast", "steps_in_consecutive_clocks",
-        "index_at_steps"),
+        "index_at_steps", "step_pairs_at_bounds", "steps_at_patterned_ceilings",
+        "free_range_ignores_ceiling", "index_gate_each_state"),
     "enc_qei_timing": qei_first(
         "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "snapshot_deltas_held",
         "stall_timeout_exact",
@@ -1020,7 +1023,16 @@ def main() -> int:
 
     def corner_task(c: Corner) -> None:
         n = args.n or MODULES[c.module].get("n", DEFAULT_N)
-        ms = generate(root, c, n, args.seed, args.mutation or None, keep=args.keep)
+        try:
+            ms = generate(root, c, n, args.seed, args.mutation or None, keep=args.keep)
+        except RuntimeError as e:
+            if not args.mutation:
+                raise
+            # a given mutation names a cell of one corner's netlist: elsewhere it may not exist
+            with lock:
+                print(f"  {c.module} {c.label}: the given mutation(s) do not apply here, skipped "
+                      f"({str(e).strip().splitlines()[-1]})", flush=True)
+            return
         with lock:
             mutants.extend(ms)
             total[0] += len(ms)

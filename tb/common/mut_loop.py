@@ -247,16 +247,18 @@ def _register() -> None:
             slot.module, slot.name = t.module, t.name  # cocotb seeds from these, as in make test
             slot.expect_fail, slot.expect_error = t.expect_fail, t.expect_error
             slot.timeout = loop.timeout_of(t)
-            if ctl is None:
-                raise RuntimeError("mut_loop: no root module mut_ctl (harness.run adds it in "
-                                   "mutation mode)")
-            ctl.sel.value = Immediate(k)
             loop.running = t
             loop.t0 = time.monotonic()
             loop.sim0 = get_sim_time("ns")
             loop.write()
 
             async def run():
+                # (here, not above: cocotb may call the function in the ReadOnly phase of the
+                # previous test's end, where no value can be written)
+                if ctl is None:
+                    raise RuntimeError("mut_loop: no root module mut_ctl (harness.run adds it in "
+                                       "mutation mode)")
+                ctl.sel.value = Immediate(k)
                 # the mutant is really selected (a flow that cannot select one cannot fail)
                 assert int(ctl.sel.value) == k, f"mut_ctl.sel is {ctl.sel.value}, not {k}"
                 await t.func(dut, *t.args, **t.kwargs)

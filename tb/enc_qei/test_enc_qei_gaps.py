@@ -9,6 +9,8 @@ same two configurations (enc_qei_wb COUNT_W 32 / TS_W 32, enc_qei_axil COUNT_W 6
 
 from __future__ import annotations
 
+import random
+
 import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
@@ -488,6 +490,110 @@ async def steps_in_consecutive_clocks(dut):
                 await env.check(model, what)
                 stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
                 assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+# the CEILINGs of the step-pair test: 0, 1 (every count but 0 is at it), small, high bits
+def _pair_ceilings(count_w):
+    return [0, 1, 0x8000_8021]
+
+
+@cocotb.test()
+async def step_pairs_at_bounds(dut):
+    """Two steps in consecutive clocks (down-up, up-down, up-up) from counts at, just above and
+    just below CEILING and at 0 / 1, every bounded range, CEILING 0 and 1 too: COUNT, EVENTS and
+    STATUS.STOPPED after each pair (an event missed in one pair cannot hide behind the same event
+    of a later one)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("limit", "non_recycle", "modulo"):
+        for ceiling in _pair_ceilings(env.count_w):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            for start in _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, 1], 0, top):
+                for pair in ((-1, +1), (+1, -1), (+1, +1)):
+                    await bus.set_count(start)
+                    model.write_count(start)
+                    await env.settle(4)
+                    await play_clocks(env, model, step_clocks(env.pos, pair))
+                    await env.settle(4)
+                    what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps {pair}"
+                    await env.check(model, what)
+                    stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                    assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb.test()
+async def steps_at_patterned_ceilings(dut):
+    """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
+    list every run), each range, counts one step and one or five units of a 16-bit slice away:
+    the slice comparators of the at-CEILING flags with every carry pattern, under steps in
+    consecutive clocks (the BURST of steps_in_consecutive_clocks)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    pick = random.Random(1414)
+    for i in range(12):
+        mode = ("modulo", "limit", "non_recycle")[i % 3]
+        sl = pick.randrange(0, env.count_w // 16)
+        ceiling = pick.getrandbits(env.count_w) >> pick.randrange(0, env.count_w)
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+        for d in (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl)):
+            start = ceiling + d
+            if not 0 <= start <= top:
+                continue
+            await bus.set_count(start)
+            model.write_count(start)
+            await env.settle(4)
+            await play_clocks(env, model, step_clocks(env.pos, BURST))
+            await env.settle(4)
+            await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
+
+
+@cocotb.test()
+async def free_range_ignores_ceiling(dut):
+    """RANGE free with CEILING set below the top (free ignores it): steps in consecutive clocks
+    across CEILING, and at 0 and the top: COUNT and EVENTS as the model's (no wrap at CEILING)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for ceiling in (0, 0x25, 0x8000_8021):
+        await env.setup(model, rng_mode="free", filter_len=1, count=0, ceiling=ceiling)
+        for start in _near([ceiling - 1, ceiling, ceiling + 1, 0, top], 0, top):
+            await bus.set_count(start)
+            model.write_count(start)
+            await env.settle(4)
+            await play_clocks(env, model, step_clocks(env.pos, BURST))
+            await env.settle(4)
+            await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
+
+
+@cocotb.test()
+async def index_gate_each_state(dut):
+    """INDEX_CTRL gate (GATE_EN, GATE_A, GATE_B) at each of the four states, a Z pulse in each
+    state: the INDEX event and the latch only for the gate's state (model's index qualifier)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    await env.setup(model, filter_len=1, count=100)
+    for gate in QUAD:
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="latch", EDGE="rising", ARM=1,
+                                        GATE_EN=1, GATE_A=gate[0], GATE_B=gate[1]))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "latch", False, "rising"
+        model.idx_gate, model.idx_arm = tuple(gate), True
+        await env.settle(4)
+        await bus.events()
+        model.take_events()
+        for k in range(4):  # one step, then a Z pulse (one clock) in the state reached
+            await play_clocks(env, model, step_clocks(env.pos, (1, 0, 0, 0), (0, 0, 1, 0)))
+            await env.settle(4)
+            await env.check(model, f"gate {gate}, Z pulse in state {QUAD[env.pos % 4]}")
+            latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+            assert latch == model.idx_latch, \
+                f"gate {gate}, Z in {QUAD[env.pos % 4]}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
+    await bus.wr("INDEX_CTRL", 0)
 
 
 @cocotb.test()
