@@ -23,7 +23,7 @@
 // RANGE and the index controls (INDEX_CTRL: ACTION, ARM, ONESHOT) act one clock after they change.
 // CEILING: the range uses the ceiling input as of two clocks earlier (a CEILING write acts two
 // clocks after it; the core keeps a pipeline of it so that count >= CEILING is a flag register).
-// COUNT_LO writes load the count one clock after their strobe (the value: the written low word
+// COUNT_LO writes load the count two clocks after their strobe (the value: the written low word
 // and the staged high word of the strobe's clock); an index preset loads PRESET of the clock
 // before (both registered in the core with their comparisons, for Fmax).
 // x1_hyst (Figure 14) is proven in formal/enc_x1_hysteresis.sby; here its steps are taken from the
@@ -398,13 +398,16 @@ module enc_qei_core_formal #(
   wire               f_preset = f_ihit & f_armed & (f_act == I_PRESET);
   wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};  // the value a COUNT_LO write loads
   wire [COUNT_W-1:0] f_wr = f_wr64[COUNT_W-1:0];
-  // a COUNT_LO write loads the count one clock after its strobe (f_lw_q, f_wr_q), an index preset
+  // a COUNT_LO write loads the count two clocks after its strobe (f_lw_q, f_wr_q), an index preset
   // loads PRESET as it was one clock earlier (f_pre_q)
-  reg                f_lw_q = 1'b0;
-  reg  [COUNT_W-1:0] f_wr_q = {COUNT_W{1'b0}}, f_pre_q = {COUNT_W{1'b0}};
+  reg                f_lw1_q = 1'b0, f_lw_q = 1'b0;
+  reg  [COUNT_W-1:0] f_wr1_q = {COUNT_W{1'b0}}, f_wr_q = {COUNT_W{1'b0}};
+  reg  [COUNT_W-1:0] f_pre_q = {COUNT_W{1'b0}};
   always @(posedge clk) begin
-    f_lw_q  <= ~rst & count_lo_wr;
-    f_wr_q  <= f_wr;
+    f_lw1_q <= ~rst & count_lo_wr;
+    f_lw_q  <= ~rst & f_lw1_q;
+    f_wr1_q <= f_wr;
+    f_wr_q  <= f_wr1_q;
     f_pre_q <= preset;
   end
   wire               f_load = f_lw_q | f_preset;

@@ -19,9 +19,9 @@
 // For Fmax, the range's decisions (wrap, stop, hold at CEILING or 0), the zero test and the
 // loads are flag registers, set a clock ahead from the next count's candidates: CEILING acts two
 // clocks after it changes, RANGE and INDEX_CTRL one clock after, a COUNT_LO write loads the count
-// one clock after its strobe (with the COUNT_HI word staged as of the strobe), and an index
-// preset loads PRESET as it was one clock earlier. A bus access takes longer than these delays:
-// software cannot tell.
+// two clocks after its strobe (its value as of the strobe, with the COUNT_HI word staged then),
+// and an index preset loads PRESET as it was one clock earlier. A bus access takes longer than
+// these delays: software cannot tell.
 `default_nettype none
 
 module enc_qei_core #(
@@ -239,6 +239,14 @@ module enc_qei_core #(
     end
   end
 
+  // a copy of step_dn for the count's adder alone ((* keep *): Yosys would merge it back; Fmax:
+  // one register driving the adder's carry chains and the range logic is a long net)
+  reg step_dn_add_q;
+
+  (* keep *) always @(posedge clk) begin
+    step_dn_add_q <= ~rst & en & fdn;
+  end
+
   assign step_up     = step_up_q;
   assign step_dn     = step_dn_q;
   assign edge_any    = edge_any_q;
@@ -379,31 +387,35 @@ module enc_qei_core #(
   wire [63:0] wr_value = {hi_stage_q, count_lo_wdata};  // (the bits above COUNT_W are dropped)
   // verilator lint_on UNUSEDSIGNAL
 
-  // COUNT_LO writes and index presets, registered (Fmax): a COUNT_LO write loads the count one
-  // clock after its strobe, and an index preset loads PRESET as it was one clock earlier; the
-  // value to load, its comparison with the ceiling and its zero test are registers.
+  // COUNT_LO writes and index presets, registered (Fmax): a COUNT_LO write loads the count two
+  // clocks after its strobe (its value taken at the strobe), and an index preset loads PRESET as
+  // it was one clock earlier; the value to load, its comparison with the ceiling and its zero
+  // test are registers.
+  reg               wr_pend_q;    // a COUNT_LO write strobe one clock ago
+  reg [COUNT_W-1:0] wr_val_q;     // ... its value
   reg               wr_q;         // a COUNT_LO write to apply this clock
   reg               load_q;       // a load this clock: a COUNT_LO write or an index preset
   reg [COUNT_W-1:0] load_val_q;   // ... its value (the write first)
   reg               load_ge_q;    // ... >= the next clock's ceiling
   reg               load_zero_q;  // ... == 0
-  wire              load_wr = count_lo_wr;  // the next clock's load is a write
 
   always @(posedge clk) begin
     if (rst) begin
-      wr_q   <= 1'b0;
-      load_q <= 1'b0;
+      wr_pend_q <= 1'b0;
+      wr_q      <= 1'b0;
+      load_q    <= 1'b0;
     end else begin
-      wr_q   <= count_lo_wr;
-      load_q <= count_lo_wr | (valid & idx_hit1_q & idx_arm & (idx_action == I_PRESET));
+      wr_pend_q <= count_lo_wr;
+      wr_q      <= wr_pend_q;
+      load_q    <= wr_pend_q | (valid & idx_hit1_q & idx_arm & (idx_action == I_PRESET));
     end
   end
 
   always @(posedge clk) begin
-    load_val_q  <= load_wr ? wr_value[COUNT_W-1:0] : preset;
-    load_ge_q   <= load_wr ? ge_w(wr_value[COUNT_W-1:0], ceiling) : ge_w(preset, ceiling);
-    load_zero_q <= load_wr ? (wr_value[COUNT_W-1:0] == {COUNT_W{1'b0}}) :
-                             (preset == {COUNT_W{1'b0}});
+    wr_val_q    <= wr_value[COUNT_W-1:0];
+    load_val_q  <= wr_pend_q ? wr_val_q : preset;
+    load_ge_q   <= wr_pend_q ? ge_w(wr_val_q, ceiling) : ge_w(preset, ceiling);
+    load_zero_q <= wr_pend_q ? (wr_val_q == {COUNT_W{1'b0}}) : (preset == {COUNT_W{1'b0}});
   end
 
   // ---- range decisions: flag registers (Fmax) ------------------------------------------------------
@@ -448,7 +460,7 @@ module enc_qei_core #(
 
   // Every value is an AND-OR of (select & candidate): the selects are early signals, the adder,
   // comparators and zero tests of count_q the late ones, which enter the last logic levels only
-  // (Fmax). The step: one adder, count_q + 1 or count_q - 1 by step_dn (a register).
+  // (Fmax). The step: one adder, count_q + 1 or count_q - 1 by step_dn (its copy step_dn_add_q).
   wire [COUNT_W-1:0] count_step;
 
   generate
@@ -456,15 +468,15 @@ module enc_qei_core #(
       // carry select: the low 16 bits' carry out picks the high part with carry in 0 or 1
       // (two short chains side by side instead of one long one; Fmax)
       localparam integer HI_W = COUNT_W - 16;
-      wire [16:0]     lo_sum = {1'b0, count_q[15:0]} + {1'b0, {15{step_dn}}, 1'b1};
+      wire [16:0]     lo_sum = {1'b0, count_q[15:0]} + {1'b0, {15{step_dn_add_q}}, 1'b1};
       wire [HI_W-1:0] hi     = count_q[COUNT_W-1:16];
-      wire [HI_W-1:0] hi_c0  = hi + {HI_W{step_dn}};
+      wire [HI_W-1:0] hi_c0  = hi + {HI_W{step_dn_add_q}};
       // verilator lint_off UNUSEDSIGNAL
-      wire [HI_W:0]   hi_c1x = {hi, 1'b1} + {{HI_W{step_dn}}, 1'b1};  // (hi + ... + 1) << 1 | 0
+      wire [HI_W:0]   hi_c1x = {hi, 1'b1} + {{HI_W{step_dn_add_q}}, 1'b1};  // (hi + ... + 1) << 1 | 1
       // verilator lint_on UNUSEDSIGNAL
       assign count_step = {lo_sum[16] ? hi_c1x[HI_W:1] : hi_c0, lo_sum[15:0]};
     end else begin : g_step
-      assign count_step = count_q + {{(COUNT_W-1){step_dn}}, 1'b1};
+      assign count_step = count_q + {{(COUNT_W-1){step_dn_add_q}}, 1'b1};
     end
   endgenerate
 
@@ -510,12 +522,10 @@ module enc_qei_core #(
   //   [0] hold | +1 (the late ones)   [1] -1 (late) | the rest (early)
   function [1:0] parts;
     input [2:0] late;   // the gated selects of hold, +1 and -1
-    input [7:0] sel_g;  // all selects, gated by the range
-    reg   [7:0] t;
+    input       early;  // the OR of the early cases' terms
     begin
-      t        = sel_g & c_cand & 8'b1100_1011;  // the early cases
       parts[0] = (late[2] & cand_hold) | (late[1] & cand_inc);
-      parts[1] = (late[0] & cand_dec) | (|t);
+      parts[1] = (late[0] & cand_dec) | early;
     end
   endfunction
 
@@ -530,12 +540,17 @@ module enc_qei_core #(
   assign late_lim = {sel_lim[5], sel_lim[4], sel_lim[2]};
   (* keep *) wire [2:0] late_bnd;
   assign late_bnd = {sel_bnd[5], sel_bnd[4], sel_bnd[2]};
+  // (keep: the early cases' terms are ORed apart from the late ones, for the same reason)
+  localparam [7:0] EARLY = 8'b1100_1011;  // rst, load, +1 wrapping, ->0, ->CEILING
+  (* keep *) wire [2:0] early_g;           // {modulo, limit, bounded}
+  assign early_g = {|(sel_mod & c_cand & EARLY), |(sel_lim & c_cand & EARLY),
+                    |(sel_bnd & c_cand & EARLY)};
 
   always @(posedge clk) begin
     zero_q    <= |(sel & z_cand);
-    up_wrap_q <= parts(late_mod, sel_mod);
-    up_lim_q  <= parts(late_lim, sel_lim);
-    up_blk_q  <= parts(late_bnd, sel_bnd);
+    up_wrap_q <= parts(late_mod, early_g[2]);
+    up_lim_q  <= parts(late_lim, early_g[1]);
+    up_blk_q  <= parts(late_bnd, early_g[0]);
     dn_wrap_q <= |(sel_mod & z_cand);
     dn_lim_q  <= |(sel_lim & z_cand);
     dn_blk_q  <= stop_n | (|(sel_bnd & z_cand));
@@ -671,6 +686,8 @@ module enc_qei_core #(
   initial ceil_zero_q = 1'b1;
   initial ceil_wrap_ge_q = 1'b1;
   initial wr_q = 1'b0;
+  initial wr_pend_q = 1'b0;
+  initial wr_val_q = {COUNT_W{1'b0}};
   initial load_q = 1'b0;
   initial load_val_q = {COUNT_W{1'b0}};
   initial load_ge_q = 1'b1;
@@ -691,6 +708,8 @@ module enc_qei_core #(
   initial dn_lim_q = 1'b0;
   initial dn_blk_q = 1'b0;
   initial stop_q = 1'b0;
+  initial step_dn_q = 1'b0;
+  initial step_dn_add_q = 1'b0;
   wire f_at_ceil = (count_q >= ceil_q);
   always @(*) begin
     assert (ceil_nx_m1n_q == ~(ceil_nx - {{(COUNT_W-1){1'b0}}, 1'b1}));
@@ -701,6 +720,7 @@ module enc_qei_core #(
     assert (ceil_wrap_ge_q == (ceil_q >= ceil_nx));
     assert (load_ge_q == (load_val_q >= ceil_nx));
     assert (load_zero_q == (load_val_q == {COUNT_W{1'b0}}));
+    assert (step_dn_add_q == step_dn_q);
     assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == I_PRESET))));
     assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == I_LATCH)));
     assert (stop_q == (r_nr & stopped_q));

@@ -7,7 +7,8 @@
 // registered on the way in (timing), so everything here sees the core one clock late, all alike:
 // an edge's timestamp is the timebase in the clock after the count took it, and a snapshot holds
 // the count register (`count`, which already includes the previous clock's step) with the edges
-// and steps up to that same point.
+// and steps up to that same point. SNAP_CTRL.EDGE, PERIOD_CTRL.EDGE and SNAP_PERIOD act one
+// clock after they change, PERIOD_CTRL.N two (registered on the way in: Fmax).
 // Snapshot: a request -- snap_cmd, a rising edge of snap_in while snap_in_en, or the unit timer
 // (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in one clock (the next):
 //   SNAP_COUNT      the count register now (count)
@@ -76,24 +77,44 @@ module enc_qei_timing #(
   localparam [TS_W-1:0] TS_ZERO = {TS_W{1'b0}};
   localparam [TS_W-1:0] TS_MAX  = {TS_W{1'b1}};
   // ---- inputs from the core, registered --------------------------------------------------------------
-  reg edge_any_q, edge_a_rise_q, step_q, dn_q, mv_q, dir_change_q;  // mv_q: a step up or down
+  // The edges come registered already chosen by SNAP_CTRL.EDGE / PERIOD_CTRL.EDGE (which thus act
+  // a clock after they change), and the step (+1, -1 or 0: mv, dn) once for each of the three
+  // step adders below: (* keep *) on their blocks keeps Yosys from merging the copies (Fmax: one
+  // register driving all three adders' carry chains is a long net).
+  reg sel_snap_q;  // an edge of type SNAP_CTRL.EDGE (0 any edge, 1 A rising)
+  reg sel_per_q;   // an edge of type PERIOD_CTRL.EDGE
+  reg step_q, dir_change_q;
+  reg mv_d_q, dn_d_q;  // a step up or down (mv), down (dn): for delta_q's adder
+  reg mv_t_q, dn_t_q;  // ... tail_q's
+  reg mv_a_q, dn_a_q;  // ... acc_q's
 
   always @(posedge clk) begin
     if (rst) begin
-      edge_any_q    <= 1'b0;
-      edge_a_rise_q <= 1'b0;
-      step_q        <= 1'b0;
-      dn_q          <= 1'b0;
-      mv_q          <= 1'b0;
-      dir_change_q  <= 1'b0;
+      sel_snap_q   <= 1'b0;
+      sel_per_q    <= 1'b0;
+      step_q       <= 1'b0;
+      dir_change_q <= 1'b0;
     end else begin
-      edge_any_q    <= edge_any;
-      edge_a_rise_q <= edge_a_rise;
-      step_q        <= step;
-      dn_q          <= applied_dn;
-      mv_q          <= applied_up | applied_dn;
-      dir_change_q  <= dir_change;
+      sel_snap_q   <= snap_edge ? edge_a_rise : edge_any;
+      sel_per_q    <= period_edge ? edge_a_rise : edge_any;
+      step_q       <= step;
+      dir_change_q <= dir_change;
     end
+  end
+
+  (* keep *) always @(posedge clk) begin
+    mv_d_q <= ~rst & (applied_up | applied_dn);
+    dn_d_q <= ~rst & applied_dn;
+  end
+
+  (* keep *) always @(posedge clk) begin
+    mv_t_q <= ~rst & (applied_up | applied_dn);
+    dn_t_q <= ~rst & applied_dn;
+  end
+
+  (* keep *) always @(posedge clk) begin
+    mv_a_q <= ~rst & (applied_up | applied_dn);
+    dn_a_q <= ~rst & applied_dn;
   end
 
   // ---- timebase ----------------------------------------------------------------------------------
@@ -134,11 +155,19 @@ module enc_qei_timing #(
   // ---- snapshot ------------------------------------------------------------------------------------
   // unit timer: counts down from SNAP_PERIOD - 1 once per tick, snaps on the tick at 0
   // (unit_zero_q: unit_q == 0, a registered flag)
+  // (SNAP_PERIOD - 1 and its zero test are registers: SNAP_PERIOD acts one clock after it
+  // changes, Fmax)
   reg  [TS_W-1:0] unit_q;
   reg             unit_zero_q;
   reg             snap_in_q;
-  wire [TS_W-1:0] unit_load = (snap_period == TS_ZERO) ? TS_ZERO : snap_period - TS_ONE;
+  reg  [TS_W-1:0] unit_load_q;       // SNAP_PERIOD - 1 (0 for 0)
+  reg             unit_load_zero_q;  // ... == 0 (SNAP_PERIOD 0 or 1)
   wire            unit_hit  = snap_period_en & tick & unit_zero_q;
+
+  always @(posedge clk) begin
+    unit_load_q      <= (snap_period == TS_ZERO) ? TS_ZERO : snap_period - TS_ONE;
+    unit_load_zero_q <= (snap_period[TS_W-1:1] == {(TS_W-1){1'b0}});
+  end
   // the request is registered (Fmax): the snapshot is taken in the clock after it, all values
   // of that one clock
   reg             snap_req;
@@ -153,8 +182,8 @@ module enc_qei_timing #(
       snap_in_q <= snap_in;
       snap_req  <= snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
       if (~snap_period_en | unit_hit) begin
-        unit_q      <= unit_load;
-        unit_zero_q <= (snap_period[TS_W-1:1] == {(TS_W-1){1'b0}});  // SNAP_PERIOD 0 or 1
+        unit_q      <= unit_load_q;
+        unit_zero_q <= unit_load_zero_q;
       end else if (tick) begin
         unit_q      <= unit_q - TS_ONE;
         unit_zero_q <= (unit_q == TS_ONE);
@@ -162,18 +191,36 @@ module enc_qei_timing #(
     end
   end
 
-  wire        sel_snap  = snap_edge ? edge_a_rise_q : edge_any_q;
+  wire        sel_snap  = sel_snap_q;
   // +1, -1 or 0 (applied_up and applied_dn never come together): straight from registers into
   // the adders' carry chains (Fmax)
-  wire [31:0] s_now     = {{31{dn_q}}, mv_q};
+  // x + 1, x - 1 or x (mv, dn: a step, down), by carry select: the low half's carry out picks the
+  // high half with carry in 0 or 1 (two 16-bit chains side by side instead of one of 32; Fmax)
+  function [31:0] step32;
+    input [31:0] x;
+    input        mv;
+    input        dn;
+    reg   [16:0] lo;
+    reg   [15:0] hi_c0;
+    // verilator lint_off UNUSEDSIGNAL
+    reg   [16:0] hi_c1x;  // {hi + ... + 1, 1} (bit 0 unused)
+    // verilator lint_on UNUSEDSIGNAL
+    begin
+      lo     = {1'b0, x[15:0]} + {1'b0, {15{dn}}, mv};
+      hi_c0  = x[31:16] + {16{dn}};
+      hi_c1x = {x[31:16], 1'b1} + {{16{dn}}, 1'b1};
+      step32 = {lo[16] ? hi_c1x[16:1] : hi_c0, lo[15:0]};
+    end
+  endfunction
+
   reg  [31:0] delta_q;      // applied steps since the previous snapshot
   reg  [31:0] tail_q;       // applied steps since the last selected edge
   reg  [31:0] head_q;       // steps from the previous snapshot's last selected edge to the last one
   reg  [31:0] acc_q;        // head_q + tail_q, kept by its own adder (no adder chain for Fmax)
   reg  [TS_W-1:0] last_edge_q;  // timestamp of the last selected edge
-  wire [31:0] delta_now = delta_q + s_now;
-  wire [31:0] tail_now  = sel_snap ? 32'd0 : tail_q + s_now;
-  wire [31:0] acc_now   = acc_q + s_now;  // = head_q + tail_q + s_now
+  wire [31:0] delta_now = step32(delta_q, mv_d_q, dn_d_q);
+  wire [31:0] tail_now  = sel_snap ? 32'd0 : step32(tail_q, mv_t_q, dn_t_q);
+  wire [31:0] acc_now   = step32(acc_q, mv_a_q, dn_a_q);  // = head_q + tail_q + this step
   wire [31:0] head_now  = sel_snap ? acc_now : head_q;
   wire [TS_W-1:0] edge_now = sel_snap ? tb_q : last_edge_q;
 
@@ -216,9 +263,9 @@ module enc_qei_timing #(
   end
 
   // ---- period ---------------------------------------------------------------------------------------
-  // (n_last_q: n_q == PERIOD_CTRL.N - 1 as of the last clock, so a new N counts from the clock
-  // after the write; ticks_max_q: ticks_q == all ones; both registered flags: Fmax)
-  wire       sel_per  = period_edge ? edge_a_rise_q : edge_any_q;
+  // (n_last_q: n_q == PERIOD_CTRL.N - 1 as of two clocks ago, so a new N counts from the second
+  // clock after the write; ticks_max_q: ticks_q == all ones; both registered flags: Fmax)
+  wire       sel_per  = sel_per_q;
   reg        started_q, ovf_q, dir_q, ticks_max_q;
   reg [7:0]  n_q;
   reg [TS_W-1:0] ticks_q;
@@ -245,13 +292,39 @@ module enc_qei_timing #(
     end
   end
 
+  // N - 1 and N - 2 as registers (Fmax: PERIOD_CTRL.N reaches the flag a clock later): n_last_q
+  // is set from the next value's case, each compared with them
+  reg [7:0] per_last_q;       // N - 1 (0 for N = 0)
+  reg [7:0] per_last_m1_q;    // ... - 1
+  reg       per_last_zero_q;  // ... == 0
+
+  always @(posedge clk) begin
+    per_last_q      <= per_last_d;
+    per_last_m1_q   <= per_last_d - 8'd1;
+    per_last_zero_q <= (per_last_d == 8'd0);
+  end
+
+  reg n_last_d;  // n_d == per_last_q
+
+  always @(*) begin
+    if (!period_en) begin
+      n_last_d = (n_q == per_last_q);
+    end else if (sel_per & (~started_q | n_last)) begin
+      n_last_d = per_last_zero_q;
+    end else if (started_q & sel_per) begin
+      n_last_d = (n_q == per_last_m1_q);
+    end else begin
+      n_last_d = (n_q == per_last_q);
+    end
+  end
+
   always @(posedge clk) begin
     if (rst) begin
       n_q      <= 8'd0;
       n_last_q <= 1'b1;
     end else begin
       n_q      <= n_d;
-      n_last_q <= (n_d == per_last_d);
+      n_last_q <= n_last_d;
     end
   end
 
