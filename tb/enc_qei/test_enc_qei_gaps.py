@@ -641,6 +641,16 @@ async def index_at_steps(dut):
                                 f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
                     await env.settle(4)
                     await env.check(model, what)
+                    if action == "preset" and ceiling == 0x25:
+                        # a preset in the clock of a down step from 1 / from 0, then a step in the
+                        # next clock (the load wins: the flags must be the preset value's)
+                        for before, steps in ((1, (-1, -1, 0)), (0, (-1, +1, 0)), (1, (-1, +1, 0))):
+                            await bus.set_count(before)
+                            model.write_count(before)
+                            await env.settle(4)
+                            await play_clocks(env, model, step_clocks(env.pos, steps, (1, 0, 0)))
+                            await env.settle(4)
+                            await env.check(model, f"{what}; preset with a down step from {before}")
                 await bus.wr("INDEX_CTRL", 0)
                 model.idx_action = "none"
 
@@ -683,9 +693,9 @@ async def unit_timer_prescaled(dut):
 @cocotb.test()
 async def snapshot_deltas_held(dut):
     """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
-    an odd and an even number of clocks apart, after walks forward and back (positive and negative
-    deltas, EDGE any and A rising): always the applied steps since the previous snapshot, and the
-    count change between the last selected edges of the two snapshots."""
+    an odd and an even number of clocks apart, after walks forward, back and turning between two
+    snapshots (positive and negative deltas, EDGE any and A rising): always the applied steps since
+    the previous snapshot, and the count change between the last selected edges of the two."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
@@ -694,8 +704,11 @@ async def snapshot_deltas_held(dut):
         await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
         await env.settle(4)
         last_edge = None  # 4X position of the last selected edge up to the previous snapshot
-        for n in (9, -14, 5, -3, 22, -30):
-            steps = [1 if n > 0 else -1] * abs(n)
+        # each a walk between two snapshots; the mixed ones turn within it (an accumulator that
+        # counts down from a positive value, up from a negative one)
+        for steps in ([1] * 9, [-1] * 14, [1] * 5, [-1] * 3, [1] * 22, [-1] * 30,
+                      [1] * 7 + [-1] * 3, [-1] * 6 + [1] * 2, [1] * 3 + [-1] * 8):
+            n = sum(steps)
             wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
             await env.play(wf, model)
             rises = [p for q, p in zip(wf.positions, wf.positions[1:])
@@ -721,11 +734,21 @@ async def snapshot_deltas_held(dut):
 async def period_above_2k_ticks(dut):
     """PERIOD of edge intervals of 2,652 ticks (bits 2 .. 11 in the tick counter and PERIOD; the
     other tests measure 765 ticks at most, or the 2^16 overflow at TS_W 16): exact, and held
-    (read an odd and an even number of clocks apart)."""
+    (read an odd and an even number of clocks apart); and of 314 ticks at PRESCALE 1 and 3 (the
+    tick counter holds between ticks): within one tick."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
     await env.setup(model, count=0, filter_len=1)
+    for pre in (1, 3):  # ticks PRESCALE + 1 clocks apart: clocks without a tick in between
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+        clocks = 0x13A * (pre + 1) + 1
+        await env.play(walk([1, 1, 1], [clocks * T_NS] * 3, start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        assert abs(period - 0x13A) <= 1, f"PRESCALE {pre}: PERIOD {period:#x}, expected 0x13a (+-1)"
+        await bus.wr("PERIOD_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
     d = 0x0A5C
     await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
     await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
