@@ -124,7 +124,7 @@ QEI_ALL = _qei(
     G + "unit_timer_period", "func_walks", G + "steps_in_consecutive_clocks", G + "index_at_steps",
     G + "unit_timer_prescaled", G + "snapshot_deltas_held", G + "period_above_2k_ticks",
     G + "step_pairs_at_bounds", G + "steps_at_patterned_ceilings", G + "free_range_ignores_ceiling",
-    G + "index_gate_each_state")
+    G + "index_gate_each_state", G + "one_clock_reset_in_motion")
 
 
 def qei_first(*names: str) -> list[str]:

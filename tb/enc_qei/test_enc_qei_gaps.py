@@ -120,7 +120,7 @@ async def stall_timeout_exact(dut):
     await bus.wr("IRQ_EN", event_bits("STALL"))
     clocks = {}
     for pre, t in ((0, 0x40), (0, 0x2F), (0, 0x1F0), (0, 0x2A5), (0, 0x35A), (0, 0x0CB), (0, 0x104),
-                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
+                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 4), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
                    (2, 0x6D)):
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("STALL_TIMEOUT", t)
@@ -758,6 +758,33 @@ async def period_above_2k_ticks(dut):
         if gap:
             await ClockCycles(dut.clk, gap)
     await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb.test()
+async def one_clock_reset_in_motion(dut):
+    """A reset of one clock in each clock around an applied down step (and up step): afterwards
+    SNAP_DELTA (a snapshot by command, the shaft still) is 0 and COUNT is 0 -- nothing of the
+    step before the reset leaks into the accumulators after it."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for direction in (-1, 1):
+        for offset in range(0, 9):
+            model = QeiModel(env.count_w)
+            await env.setup(model, count=50, filter_len=1)
+            await FallingEdge(dut.clk)
+            env.pos += direction
+            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+            await ClockCycles(dut.clk, offset)
+            await FallingEdge(dut.clk)
+            dut.rst.value = 1
+            await FallingEdge(dut.clk)
+            dut.rst.value = 0
+            await env.settle(30)
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+            await env.settle(4)
+            delta = await bus.rd("SNAP_DELTA")
+            assert delta == 0, f"step {direction}, reset {offset} clocks after: SNAP_DELTA {delta:#x}"
+            assert await bus.count() == 0, f"step {direction}, reset {offset} clocks after: COUNT not 0"
 
 
 # ---- register block -----------------------------------------------------------------------------------------
