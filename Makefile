@@ -64,8 +64,8 @@ synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K; enc_qei also ECP5) and th
 bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
 	$(PY) scripts/synth.py --only icebreaker_top --bitstream
 
-formal: $(STAMP) ## SymbiYosys proofs (k-induction) and covers of the counting circuits, one .sby per block (SLOW=1: also prove_w34)
-	$(PY) scripts/formal.py --jobs $(JOBS) $(if $(filter 1,$(SLOW)),--slow)
+formal: $(STAMP) ## SymbiYosys proofs (k-induction) and covers of the counting circuits, one .sby per block
+	$(PY) scripts/formal.py --jobs $(JOBS)
 
 mutate: $(STAMP) ## mutation coverage: Yosys mutants of every RTL module against its tests (MUTATE_SEED=n)
 	$(PY) scripts/mutate.py --jobs $(JOBS) $(if $(MUTATE_SEED),--seed $(MUTATE_SEED))

@@ -44,8 +44,8 @@
 // Defines: PIPE_ONLY keeps only what does not depend on the count register (k-induction closes on
 // it from the ports alone); the count's induction needs the core's internal zero_q flag to agree
 // with count_q, an invariant the ports cannot show, so those properties run bounded (see the .sby).
-// NO_LATCHES drops the latch checks (COUNT_W 34 task); HI_STAGED assumes each COUNT_LO write
-// follows a COUNT_HI write (for a COUNT_W 34 induction: the staged word is invisible otherwise).
+// HI_STAGED assumes each COUNT_LO write follows a COUNT_HI write (for the COUNT_W 40 induction:
+// the staged word is invisible otherwise).
 `default_nettype none
 
 module enc_qei_core_formal #(
@@ -198,9 +198,9 @@ module enc_qei_core_formal #(
 `endif
 
 `ifdef HI_STAGED
-  // Task prove_w34: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
+  // Task prove_w40: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
   // is internal state the ports do not show until a COUNT_LO write uses it; this keeps it known
-  // to the induction). bmc_w34 checks writes without this assumption, to a bounded depth.
+  // to the induction). Writes in any order are proven at COUNT_W 8 and 16.
   always @(*) begin
     if (f_past_valid && count_lo_wr) assume (f_hi_wr_q);
   end
@@ -434,10 +434,7 @@ module enc_qei_core_formal #(
     end
   end
 
-`ifndef NO_LATCHES
   // ---- latches: INDEX_LATCH (the count after the transition's step), probe (latency 1) ---------
-  // (left out of the COUNT_W 34 task by NO_LATCHES: there they slowed the solver from seconds to
-  // more than ten minutes; the logic does not depend on the width)
   reg  f_pprev = 1'b0, f_pok = 1'b0, f_phit = 1'b0;
   reg  [COUNT_W-1:0] f_idx_latch = {COUNT_W{1'b0}}, f_probe_latch = {COUNT_W{1'b0}};
   reg  [TS_W-1:0]    f_probe_time = {TS_W{1'b0}};
@@ -465,7 +462,6 @@ module enc_qei_core_formal #(
     end
   end
 
-`endif
 
   // ---- properties: the core equals the model at every clock ---------------------------------------
   always @(*) begin
@@ -495,13 +491,11 @@ module enc_qei_core_formal #(
       assert (count_lo_rdata == f_count64[31:0]);
       assert (count_hi_rdata == f_hi_latch);
 `endif
-`ifndef NO_LATCHES
       assert (ev_probe == f_phit && probe_disarm == (f_phit & probe_once));
       assert (probe_time == f_probe_time);
 `ifndef PIPE_ONLY
       assert (idx_latch == f_idx_latch);
       assert (probe_latch == f_probe_latch);
-`endif
 `endif
       if (COUNT_W <= 32) assert (count_hi_rdata == 32'd0);
     end
@@ -614,10 +608,8 @@ module enc_qei_core_formal #(
       cover (func == F_DECREASE && applied_dn);
       cover (f_hyst_q && applied_up);
       cover (count_lo_rd && count != ZERO);
-`ifndef NO_LATCHES
       cover (f_ilatch && (step_up | step_dn));  // INDEX_LATCH takes the stepped count
       cover (ev_probe && count != ZERO && probe_time != {TS_W{1'b0}});
-`endif
     end
   end
 

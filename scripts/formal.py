@@ -13,7 +13,6 @@ trace, induction trace or cover traces) and the sby log are named.
 Options:
   --jobs N             tasks run in parallel (default 2)
   --only NAME ...      just these blocks, or single tasks as block:task
-  --slow               also the tasks in SLOW_TASKS (enc_qei_core:prove_w34; `make formal SLOW=1`)
   --list               list the blocks and their tasks, run nothing
   --timeout SECONDS    per task (default 900)
 
@@ -104,13 +103,6 @@ def list_blocks() -> dict[str, list[str]]:
     return blocks
 
 
-# Tasks left out of a default run. enc_qei_core:prove_w34 (COUNT_W > 32: LO/HI coherence, COUNT
-# writes through the staged high word) proved in 4 min once on a loaded machine and gave no result
-# in 15 min on others since the Fmax pipeline registers: its base case (bounded model check from
-# reset, depth 6) stalls in yices while its induction step passes in seconds. A task that may time
-# out would fail CI at random; simulation covers the same at COUNT_W 64 (test_enc_qei
-# coherent_64bit) on every run.
-SLOW_TASKS = {"enc_qei_core:prove_w34"}
 
 
 def check_tools() -> dict[str, str]:
@@ -238,8 +230,6 @@ def main() -> int:
     parser.add_argument("--only", nargs="+", metavar="NAME",
                         help="just these blocks, or single tasks as block:task")
     parser.add_argument("--list", action="store_true", help="list blocks and tasks, run nothing")
-    parser.add_argument("--slow", action="store_true",
-                        help="also the tasks in SLOW_TASKS (left out by default: see there)")
     parser.add_argument("--timeout", type=float, default=900.0,
                         help="seconds per task before it counts as failed (default 900)")
     args = parser.parse_args()
@@ -267,12 +257,7 @@ def main() -> int:
                 if not any(s.block == block and s.task == tk for s in selected):
                     selected.append(Task(block, tk))
     else:
-        selected = [Task(b, tk) for b, tasks in blocks.items() for tk in tasks
-                    if args.slow or f"{b}:{tk}" not in SLOW_TASKS]
-        skipped = sorted(f"{b}:{tk}" for b, tasks in blocks.items() for tk in tasks
-                         if not args.slow and f"{b}:{tk}" in SLOW_TASKS)
-        if skipped:
-            print(f"formal: left out (run them with --slow, or make formal SLOW=1): {', '.join(skipped)}")
+        selected = [Task(b, tk) for b, tasks in blocks.items() for tk in tasks]
 
     # Longest first (by the last run's times), so the slow tasks do not start last.
     times_file = TOP / BUILD_REL / "last_seconds.json"
