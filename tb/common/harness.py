@@ -20,6 +20,12 @@ Mutation testing (scripts/mutate.py sets these; nothing else needs them):
   ENC_RTL_OVERRIDE  "rtl/x.v=/abs/mutant.v[,rtl/y.v=...]": rtl_sources() lists that file instead of
                     the core's rtl/x.v (the real rtl/ is never touched)
   ENC_BUILD_ROOT    build root instead of sim/build (builds go to <root>/<sim>/<name>)
+  MUT_LOOP_IDS      "1,2,...": mutation mode of scripts/mutate.py. The design holds all mutants of
+                    a module (Yosys `mutate -ctrl`), selected by the register `mut_ctl.sel` of an
+                    extra root module added here; instead of ``test_module`` the cocotb module
+                    mut_loop runs that module's tests against mutant 0 and each listed mutant
+                    (tb/common/mut_loop.py), writing its verdicts to MUT_LOOP_DIR/<name>.json.
+                    Failing tests are expected then; run() does not raise for them.
 """
 
 from __future__ import annotations
@@ -150,6 +156,23 @@ def run(
         # the project's one waiver file (reasons inside): the same one `make lint` uses
         build_args += ["-j", "2", str(RTL / "lint_waivers.vlt")]
 
+    env = dict(extra_env or {})
+    mutation_mode = os.environ.get("MUT_LOOP_IDS") is not None
+    if mutation_mode:
+        if sim != "icarus":
+            raise SystemExit("mutation mode (MUT_LOOP_IDS) runs on Icarus only")
+        ctl = build_dir / "mut_ctl.v"
+        # no initial value: an `initial` (or an initializer) runs at time 0 after cocotb's first
+        # test has set sel, and would undo it (mut_loop sets sel before every test)
+        ctl.write_text("module mut_ctl;\n  reg [15:0] sel;\nendmodule\n")
+        sources.append(ctl)
+        build_args += ["-s", "mut_ctl"]
+        verdicts = Path(os.environ.get("MUT_LOOP_DIR") or build_dir) / f"{name}.json"
+        verdicts.parent.mkdir(parents=True, exist_ok=True)
+        env.update(MUT_LOOP_MODULE=test_module, MUT_LOOP_TESTCASE=testcase or "",
+                   MUT_LOOP_RESULTS=str(verdicts))
+        test_module, testcase = "mut_loop", None
+
     runner = IcarusVcd() if (waves and sim == "icarus") else get_runner(sim)
     runner.build(
         sources=sources,
@@ -162,7 +185,6 @@ def run(
         always=True,
         log_file=build_dir / "build.log" if quiet else None,
     )
-    env = dict(extra_env or {})
     seed = os.environ.get("SEED") or None
     results = runner.test(
         hdl_toplevel=toplevel,
@@ -178,6 +200,8 @@ def run(
     )
     # Under pytest the runner itself fails the test; from a script, fail here instead.
     tests, failed = get_results(results)
+    if mutation_mode:  # the verdicts are in MUT_LOOP_DIR/<name>.json; failures are the point
+        return
     if failed or not tests:
         log = f" (log: {build_dir / 'test.log'})" if quiet else ""
         raise RuntimeError(f"{name}: {failed} of {tests} cocotb tests failed{log}")

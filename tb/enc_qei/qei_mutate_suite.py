@@ -15,7 +15,9 @@ check. Two things differ from a normal run, both for speed only:
   never answers a bus cycle fails in seconds instead of running into scripts/mutate.py's
   wall-clock timeout.
 
-Used only through tb/enc_qei/mutate_enc_qei.py (not collected by `make test`).
+Used only through tb/enc_qei/mutate_enc_qei.py (not collected by `make test`). In the mutation
+mode of scripts/mutate.py (many mutants in one simulation, tb/common/mut_loop.py) this module only
+gives the list (mut_loop_tests); mut_loop runs it per mutant.
 """
 
 from __future__ import annotations
@@ -80,6 +82,18 @@ def _selected() -> list[Test]:
     return out
 
 
+def mut_loop_tests() -> list[Test]:
+    """The selected tests for tb/common/mut_loop.py (many mutants in one simulation: it does the
+    fail-fast itself), each with the TIMEOUT_US limit unless it has its own."""
+    out = []
+    for t in _selected():
+        w = copy.copy(t)
+        if w.timeout is None:
+            w.timeout = (TIMEOUT_US, "us")
+        out.append(w)
+    return out
+
+
 def _register() -> None:
     """cocotb discovers the Test objects of this module's namespace, in insertion order (no loop
     variable may stay behind at module level: it would be discovered too)."""
@@ -87,4 +101,5 @@ def _register() -> None:
         globals()[f"_t{i:02d}_{t.name}"] = _fail_fast(t)
 
 
-_register()
+if not os.environ.get("MUT_LOOP_MODULE"):  # mut_loop imports this module for mut_loop_tests()
+    _register()

@@ -9,6 +9,8 @@ same two configurations (enc_qei_wb COUNT_W 32 / TS_W 32, enc_qei_axil COUNT_W 6
 
 from __future__ import annotations
 
+import random
+
 import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
@@ -17,7 +19,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from harness import run
 from hedsmodel import QUAD, random_walk, walk, with_glitches
 from qei_model import QeiModel
-from qei_tb import PERIOD_PS, T_NS, event_bits, extra_sources, pack, regmap, size_mask
+from qei_tb import (PERIOD_PS, T_NS, event_bits, extra_sources, pack, play_clocks, regmap, size_mask,
+                    step_clocks)
 from test_enc_qei import begin, durations
 
 
@@ -117,7 +120,7 @@ async def stall_timeout_exact(dut):
     await bus.wr("IRQ_EN", event_bits("STALL"))
     clocks = {}
     for pre, t in ((0, 0x40), (0, 0x2F), (0, 0x1F0), (0, 0x2A5), (0, 0x35A), (0, 0x0CB), (0, 0x104),
-                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
+                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 4), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
                    (2, 0x6D)):
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("STALL_TIMEOUT", t)
@@ -440,6 +443,348 @@ async def bounded_range_fast(dut):
         await env.check(model, f"{mode} CEILING {ceiling:#x} PRESET {preset:#x} fast")
         await bus.wr("INDEX_CTRL", 0)
         model.idx_action = "none"
+
+
+# ---- steps in consecutive clocks, at loads and wraps -------------------------------------------------
+# The count keeps at-CEILING and at-zero flags in registers, computed from the next count's
+# candidates (Fmax): a step in the clock right after another step, a wrap or a load uses a flag that
+# was computed in the clock before, not recomputed from a quiet count. These tests put steps in
+# consecutive clocks (FILTER_LEN 1, one level per clock, qei_tb.play_clocks) right at those points.
+# (Ceilings: 0, small ones, a high half that equals the count's with bit 27 set, bit 31 and bit 63.)
+def _ceilings(count_w, zero=True):
+    c = ([0] if zero else []) + [0x25, 0x0800_0040, 0x8000_8021]
+    if count_w > 32:
+        c += [0x8000_0800_0000_0021]
+    return c
+
+
+def _near(values, lo, hi):
+    return sorted({v for v in values if lo <= v <= hi})
+
+
+# per clock: +1, -1 or 0 (no step); pairs in consecutive clocks, each way, with quiet clocks between
+BURST = (-1, +1, 0, 0, +1, +1, 0, 0, -1, -1, 0, 0, +1, -1, 0, 0, -1, +1, +1, 0, 0, +1, -1, -1, 0)
+
+
+@cocotb.test()
+async def steps_in_consecutive_clocks(dut):
+    """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
+    and just below CEILING, at 0 and at the top, steps in consecutive clocks both ways (an up step
+    right after a down step, a wrap right after a wrap, ...): COUNT, EVENTS and STATUS.STOPPED
+    equal the model's after each burst."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("modulo", "limit", "non_recycle", "free"):
+        for ceiling in (_ceilings(env.count_w) if mode != "free" else [top]):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            starts = _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, top], 0, top)
+            for start in starts:
+                await bus.set_count(start)
+                model.write_count(start)
+                await env.settle(4)
+                await play_clocks(env, model, step_clocks(env.pos, BURST))
+                await env.settle(4)
+                what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks"
+                await env.check(model, what)
+                stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+# the CEILINGs of the step-pair test: 0, 1 (every count but 0 is at it), small, high bits
+def _pair_ceilings(count_w):
+    return [0, 1, 0x8000_8021]
+
+
+@cocotb.test()
+async def step_pairs_at_bounds(dut):
+    """Two steps in consecutive clocks (down-up, up-down, up-up) from counts at, just above and
+    just below CEILING and at 0 / 1, every bounded range, CEILING 0 and 1 too: COUNT, EVENTS and
+    STATUS.STOPPED after each pair (an event missed in one pair cannot hide behind the same event
+    of a later one)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("limit", "non_recycle", "modulo"):
+        for ceiling in _pair_ceilings(env.count_w):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            for start in _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, 1], 0, top):
+                for pair in ((-1, +1), (+1, -1), (+1, +1)):
+                    await bus.set_count(start)
+                    model.write_count(start)
+                    await env.settle(4)
+                    await play_clocks(env, model, step_clocks(env.pos, pair))
+                    await env.settle(4)
+                    what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps {pair}"
+                    await env.check(model, what)
+                    stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                    assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb.test()
+async def steps_at_patterned_ceilings(dut):
+    """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
+    list every run), each range, counts one step and one or five units of a 16-bit slice away:
+    the slice comparators of the at-CEILING flags with every carry pattern, under steps in
+    consecutive clocks (the BURST of steps_in_consecutive_clocks)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    pick = random.Random(1414)
+    for i in range(12):
+        mode = ("modulo", "limit", "non_recycle")[i % 3]
+        sl = pick.randrange(0, env.count_w // 16)
+        ceiling = pick.getrandbits(env.count_w) >> pick.randrange(0, env.count_w)
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+        for d in (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl)):
+            start = ceiling + d
+            if not 0 <= start <= top:
+                continue
+            await bus.set_count(start)
+            model.write_count(start)
+            await env.settle(4)
+            await play_clocks(env, model, step_clocks(env.pos, BURST))
+            await env.settle(4)
+            await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
+
+
+@cocotb.test()
+async def free_range_ignores_ceiling(dut):
+    """RANGE free with CEILING set below the top (free ignores it): steps in consecutive clocks
+    across CEILING, and at 0 and the top: COUNT and EVENTS as the model's (no wrap at CEILING)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for ceiling in (0, 0x25, 0x8000_8021):
+        await env.setup(model, rng_mode="free", filter_len=1, count=0, ceiling=ceiling)
+        for start in _near([ceiling - 1, ceiling, ceiling + 1, 0, top], 0, top):
+            await bus.set_count(start)
+            model.write_count(start)
+            await env.settle(4)
+            await play_clocks(env, model, step_clocks(env.pos, BURST))
+            await env.settle(4)
+            await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
+
+
+@cocotb.test()
+async def index_gate_each_state(dut):
+    """INDEX_CTRL gate (GATE_EN, GATE_A, GATE_B) at each of the four states, a Z pulse in each
+    state: the INDEX event and the latch only for the gate's state (model's index qualifier)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    await env.setup(model, filter_len=1, count=100)
+    for gate in QUAD:
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="latch", EDGE="rising", ARM=1,
+                                        GATE_EN=1, GATE_A=gate[0], GATE_B=gate[1]))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "latch", False, "rising"
+        model.idx_gate, model.idx_arm = tuple(gate), True
+        await env.settle(4)
+        await bus.events()
+        model.take_events()
+        for k in range(4):  # one step, then a Z pulse (one clock) in the state reached
+            await play_clocks(env, model, step_clocks(env.pos, (1, 0, 0, 0), (0, 0, 1, 0)))
+            await env.settle(4)
+            await env.check(model, f"gate {gate}, Z pulse in state {QUAD[env.pos % 4]}")
+            latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+            assert latch == model.idx_latch, \
+                f"gate {gate}, Z in {QUAD[env.pos % 4]}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
+    await bus.wr("INDEX_CTRL", 0)
+
+
+@cocotb.test()
+async def index_at_steps(dut):
+    """An index preset in the clock right before steps in consecutive clocks (PRESET at, just above
+    and just below CEILING, also in another 16-bit slice), and an index latch in the very clock of
+    a wrap (down from 0 to CEILING, up from CEILING to 0) or of a step: COUNT, EVENTS and
+    INDEX_LATCH equal the model's, in every bounded range."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for action in ("preset", "latch"):
+        for mode in ("modulo", "limit", "non_recycle"):
+            for ceiling in _ceilings(env.count_w, zero=False):
+                await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
+                model.idx_action, model.idx_oneshot, model.idx_edge = action, False, "rising"
+                model.idx_gate, model.idx_arm = None, True
+                lo16 = ceiling & ~0xFFFF  # the same upper slices, a lower low slice
+                values = _near([ceiling - 1, ceiling, ceiling + 1, 0] + ([lo16 | 0x10] if action ==
+                               "preset" else []), 0, top)
+                for value in values:
+                    if action == "preset":
+                        await bus.set64("PRESET", value)
+                        model.preset = value
+                        await bus.set_count(ceiling // 2)
+                        model.write_count(ceiling // 2)
+                    else:
+                        await bus.set_count(value)
+                        model.write_count(value)
+                    await env.settle(4)
+                    # Z rises alone, then steps from the next clock on; then Z rises with a step
+                    for steps, z in (((0, +1, +1, -1, 0), (1, 1, 0, 0, 0)),
+                                     ((0, -1, -1, +1, 0), (1, 1, 0, 0, 0)),
+                                     ((-1, +1, 0), (1, 0, 0)), ((+1, -1, 0), (1, 0, 0)),
+                                     ((-1, -1, 0), (1, 0, 0)), ((+1, +1, 0), (1, 0, 0))):
+                        await play_clocks(env, model, step_clocks(env.pos, steps, z))
+                        what = f"{mode} CEILING {ceiling:#x} {action} at {value:#x}, steps {steps}"
+                        if action == "latch":  # each latch (the next Z edge overwrites it)
+                            await env.settle(4)
+                            latch = (await bus.rd("INDEX_LATCH_LO")
+                                     | await bus.rd("INDEX_LATCH_HI") << 32)
+                            assert latch == model.idx_latch, \
+                                f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
+                    await env.settle(4)
+                    await env.check(model, what)
+                    if action == "preset" and ceiling == 0x25:
+                        # a preset in the clock of a down step from 1 / from 0, then a step in the
+                        # next clock (the load wins: the flags must be the preset value's)
+                        for before, steps in ((1, (-1, -1, 0)), (0, (-1, +1, 0)), (1, (-1, +1, 0))):
+                            await bus.set_count(before)
+                            model.write_count(before)
+                            await env.settle(4)
+                            await play_clocks(env, model, step_clocks(env.pos, steps, (1, 0, 0)))
+                            await env.settle(4)
+                            await env.check(model, f"{what}; preset with a down step from {before}")
+                await bus.wr("INDEX_CTRL", 0)
+                model.idx_action = "none"
+
+
+@cocotb.test()
+async def unit_timer_prescaled(dut):
+    """The unit timer at PRESCALE 2 .. 5 (ticks 3 .. 6 clocks apart: clocks without a tick between
+    the ticks): SNAP_PERIOD = P gives a SNAP_READY exactly P x (PRESCALE + 1) clocks after the
+    previous one, and SNAP_TIME values exactly P ticks apart."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    await bus.wr("IRQ_EN", event_bits("SNAP_READY"))
+    for pre, p in ((2, 0x2D), (3, 0x24), (3, 0x28), (4, 0x1E), (5, 0x1C), (3, 0x2C), (5, 0x25)):
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("SNAP_PERIOD", p)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        seen = []
+        for k in range(4):
+            await bus.events()  # clear SNAP_READY; the next one raises irq
+            n = 0
+            while dut.irq.value == 0:
+                await RisingEdge(dut.clk)
+                n += 1
+                assert n < 4 * p * (pre + 1) + 100, f"PRESCALE {pre} SNAP_PERIOD {p}: no snapshot"
+            at = round(get_sim_time("ns") / T_NS)
+            t = await bus.rd("SNAP_TIME")
+            seen.append((at, t))
+        for (c0, t0), (c1, t1) in zip(seen[1:], seen[2:]):  # (the first one: timer phase unknown)
+            assert c1 - c0 == p * (pre + 1), \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: snapshots {c1 - c0} clocks apart, not {p * (pre + 1)}"
+            assert (t1 - t0) & ts_mask == p, \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: SNAP_TIME {t0:#x} then {t1:#x}, not {p} ticks apart"
+        await bus.wr("SNAP_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb.test()
+async def snapshot_deltas_held(dut):
+    """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
+    an odd and an even number of clocks apart, after walks forward, back and turning between two
+    snapshots (positive and negative deltas, EDGE any and A rising): always the applied steps since
+    the previous snapshot, and the count change between the last selected edges of the two."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for edge in ("any", "a_rising"):
+        await env.setup(model, count=1000, filter_len=1)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        await env.settle(4)
+        last_edge = None  # 4X position of the last selected edge up to the previous snapshot
+        # each a walk between two snapshots; the mixed ones turn within it (an accumulator that
+        # counts down from a positive value, up from a negative one)
+        for steps in ([1] * 9, [-1] * 14, [1] * 5, [-1] * 3, [1] * 22, [-1] * 30,
+                      [1] * 7 + [-1] * 3, [-1] * 6 + [1] * 2, [1] * 3 + [-1] * 8):
+            n = sum(steps)
+            wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+            await env.play(wf, model)
+            rises = [p for q, p in zip(wf.positions, wf.positions[1:])
+                     if edge == "any" or (QUAD[q % 4][0], QUAD[p % 4][0]) == (0, 1)]
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+            await env.settle(4)
+            for gap in (1, 2, 0):
+                delta = await bus.rd("SNAP_DELTA")
+                edge_delta = await bus.rd("SNAP_EDGE_DELTA")
+                assert delta == n & 0xFFFFFFFF, f"EDGE {edge}: SNAP_DELTA {delta:#x} after {n} steps"
+                if rises and last_edge is not None:
+                    exp = (rises[-1] - last_edge) & 0xFFFFFFFF
+                    assert edge_delta == exp, \
+                        f"EDGE {edge}: SNAP_EDGE_DELTA {edge_delta:#x}, expected {exp:#x} after {n} steps"
+                if gap:
+                    await ClockCycles(dut.clk, gap)
+            if rises:
+                last_edge = rises[-1]
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
+async def period_above_2k_ticks(dut):
+    """PERIOD of edge intervals of 2,652 ticks (bits 2 .. 11 in the tick counter and PERIOD; the
+    other tests measure 765 ticks at most, or the 2^16 overflow at TS_W 16): exact, and held
+    (read an odd and an even number of clocks apart); and of 314 ticks at PRESCALE 1 and 3 (the
+    tick counter holds between ticks): within one tick."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    for pre in (1, 3):  # ticks PRESCALE + 1 clocks apart: clocks without a tick in between
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+        clocks = 0x13A * (pre + 1) + 1
+        await env.play(walk([1, 1, 1], [clocks * T_NS] * 3, start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        assert abs(period - 0x13A) <= 1, f"PRESCALE {pre}: PERIOD {period:#x}, expected 0x13a (+-1)"
+        await bus.wr("PERIOD_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    d = 0x0A5C
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    for gap in (1, 2, 0):  # held: the same value at reads an odd and an even clock apart
+        period = await bus.rd("PERIOD")
+        assert period == d, f"PERIOD {period:#x}, expected {d:#x}"
+        if gap:
+            await ClockCycles(dut.clk, gap)
+    await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb.test()
+async def one_clock_reset_in_motion(dut):
+    """A reset of one clock in each clock around an applied down step (and up step): afterwards
+    SNAP_DELTA (a snapshot by command, the shaft still) is 0 and COUNT is 0 -- nothing of the
+    step before the reset leaks into the accumulators after it."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for direction in (-1, 1):
+        for offset in range(0, 9):
+            model = QeiModel(env.count_w)
+            await env.setup(model, count=50, filter_len=1)
+            await FallingEdge(dut.clk)
+            env.pos += direction
+            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+            await ClockCycles(dut.clk, offset)
+            await FallingEdge(dut.clk)
+            dut.rst.value = 1
+            await FallingEdge(dut.clk)
+            dut.rst.value = 0
+            await env.settle(30)
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+            await env.settle(4)
+            delta = await bus.rd("SNAP_DELTA")
+            assert delta == 0, f"step {direction}, reset {offset} clocks after: SNAP_DELTA {delta:#x}"
+            assert await bus.count() == 0, f"step {direction}, reset {offset} clocks after: COUNT not 0"
 
 
 # ---- register block -----------------------------------------------------------------------------------------
