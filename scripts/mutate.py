@@ -124,7 +124,8 @@ QEI_ALL = _qei(
     G + "unit_timer_period", "func_walks", G + "steps_in_consecutive_clocks", G + "index_at_steps",
     G + "unit_timer_prescaled", G + "snapshot_deltas_held", G + "period_above_2k_ticks",
     G + "step_pairs_at_bounds", G + "steps_at_patterned_ceilings", G + "free_range_ignores_ceiling",
-    G + "index_gate_each_state", G + "one_clock_reset_in_motion")
+    G + "index_gate_each_state", G + "one_clock_reset_in_motion", G + "period_consecutive_edges",
+    G + "period_held_after_disable", G + "snapshot_edge_delta_after_reversal")
 
 
 def qei_first(*names: str) -> list[str]:
@@ -156,7 +157,8 @@ QEI_ORDER = {
         "stall_timeout_exact",
         "period_large_n", "snapshot_wide_values", "stall_and_recovery", "prescaler_long",
         "snapshot_coherence", "unit_timer_period", "unit_timer_prescaled", "period_above_2k_ticks",
-        "period_capture"),
+        "period_capture", "period_consecutive_edges", "period_held_after_disable",
+        "snapshot_edge_delta_after_reversal"),
     "enc_qei_regs": qei_first(
         "register_walk", "register_patterns", "byte_enables", "byte_enables_all",
         "reset_mid_motion", "events_and_irq", "unmapped_offsets", "irq_low_in_reset",

@@ -761,6 +761,76 @@ async def period_above_2k_ticks(dut):
 
 
 @cocotb.test()
+async def period_consecutive_edges(dut):
+    """PERIOD_CTRL.N 2 .. 17 with an edge in every clock (FILTER_LEN 1, one state per clock: the
+    edge after a measurement's start edge, and the one after the next-to-last, come in the very
+    next clock): PERIOD = N ticks, N edges of one clock each."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    for n in (2, 3, 5, 10, 12, 15, 17):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=n))
+        await play_clocks(env, None, step_clocks(env.pos, [1] * (3 * n + 6)))
+        await env.settle()
+        period = await bus.rd("PERIOD")
+        assert period == n, f"N={n}, an edge every clock: PERIOD {period}, expected {n}"
+        await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb.test()
+async def period_held_after_disable(dut):
+    """PERIOD keeps the last measurement after PERIOD_CTRL.EN is cleared: a period of 0x2A5C ticks
+    (bit 13 set, within TS_W 16), read an odd and an even number of clocks apart, before and after
+    the clear."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    d = 0x2A5C
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    for enabled in (True, False):
+        if not enabled:
+            await bus.wr("PERIOD_CTRL", 0)
+        for gap in (1, 2, 3, 0):
+            period = await bus.rd("PERIOD")
+            assert period == d, f"EN {int(enabled)}: PERIOD {period:#x}, expected {d:#x}"
+            if gap:
+                await ClockCycles(dut.clk, gap)
+
+
+@cocotb.test()
+async def snapshot_edge_delta_after_reversal(dut):
+    """SNAP_CTRL.EDGE = A rising: a snapshot taken after steps back behind the last rising edge of
+    A (steps counted since that edge go down from a positive value), then walks forward through
+    more rising edges: each SNAP_EDGE_DELTA is the count change between the last rising edges of
+    A before the two snapshots."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    await env.setup(model, count=5000, filter_len=1)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="a_rising"))
+    await env.settle(4)
+    last_edge = None
+    for steps in ([1] * 6 + [-1], [1] * 9 + [-1] * 2, [1] * 7 + [-1], [1] * 10 + [-1] * 3,
+                  [1] * 13 + [-1], [1] * 5 + [-1] * 2):
+        wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+        await env.play(wf, model)
+        rises = [p for q, p in zip(wf.positions, wf.positions[1:])
+                 if (QUAD[q % 4][0], QUAD[p % 4][0]) == (0, 1)]
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="a_rising"))
+        await env.settle(4)
+        edge_delta = await bus.rd("SNAP_EDGE_DELTA")
+        if rises and last_edge is not None:
+            exp = (rises[-1] - last_edge) & 0xFFFFFFFF
+            assert edge_delta == exp, f"after {steps}: SNAP_EDGE_DELTA {edge_delta:#x}, expected {exp:#x}"
+        if rises:
+            last_edge = rises[-1]
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb.test()
 async def one_clock_reset_in_motion(dut):
     """A reset of one clock in each clock around an applied down step (and up step): afterwards
     SNAP_DELTA (a snapshot by command, the shaft still) is 0 and COUNT is 0 -- nothing of the
