@@ -466,6 +466,16 @@ def _near(values, lo, hi):
 BURST = (-1, +1, 0, 0, +1, +1, 0, 0, -1, -1, 0, 0, +1, -1, 0, 0, -1, +1, +1, 0, 0, +1, -1, -1, 0)
 
 
+async def steps_from(env, model, start, steps):
+    """Write COUNT = start (the model too), then play ``steps`` clock by clock (+1, -1 or 0 per
+    clock) and let the pipeline settle: the setup of every consecutive-clock step check below."""
+    await env.bus.set_count(start)
+    model.write_count(start)
+    await env.settle(4)
+    await play_clocks(env, model, step_clocks(env.pos, steps))
+    await env.settle(4)
+
+
 @cocotb.test()
 async def steps_in_consecutive_clocks(dut):
     """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
@@ -481,11 +491,7 @@ async def steps_in_consecutive_clocks(dut):
             await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
             starts = _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, top], 0, top)
             for start in starts:
-                await bus.set_count(start)
-                model.write_count(start)
-                await env.settle(4)
-                await play_clocks(env, model, step_clocks(env.pos, BURST))
-                await env.settle(4)
+                await steps_from(env, model, start, BURST)
                 what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks"
                 await env.check(model, what)
                 stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
@@ -512,11 +518,7 @@ async def step_pairs_at_bounds(dut):
             await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
             for start in _near([ceiling + d for d in (-1, 0, 1, 2)] + [0, 1], 0, top):
                 for pair in ((-1, +1), (+1, -1), (+1, +1)):
-                    await bus.set_count(start)
-                    model.write_count(start)
-                    await env.settle(4)
-                    await play_clocks(env, model, step_clocks(env.pos, pair))
-                    await env.settle(4)
+                    await steps_from(env, model, start, pair)
                     what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps {pair}"
                     await env.check(model, what)
                     stopped = _field("STATUS", "STOPPED", await bus.rd("STATUS"))
@@ -531,7 +533,6 @@ async def steps_at_patterned_ceilings(dut):
     consecutive clocks (the BURST of steps_in_consecutive_clocks)."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
-    bus = env.bus
     top = model.max
     pick = random.Random(1414)
     for i in range(12):
@@ -543,11 +544,7 @@ async def steps_at_patterned_ceilings(dut):
             start = ceiling + d
             if not 0 <= start <= top:
                 continue
-            await bus.set_count(start)
-            model.write_count(start)
-            await env.settle(4)
-            await play_clocks(env, model, step_clocks(env.pos, BURST))
-            await env.settle(4)
+            await steps_from(env, model, start, BURST)
             await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
 
 
@@ -557,16 +554,11 @@ async def free_range_ignores_ceiling(dut):
     across CEILING, and at 0 and the top: COUNT and EVENTS as the model's (no wrap at CEILING)."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
-    bus = env.bus
     top = model.max
     for ceiling in (0, 0x25, 0x8000_8021):
         await env.setup(model, rng_mode="free", filter_len=1, count=0, ceiling=ceiling)
         for start in _near([ceiling - 1, ceiling, ceiling + 1, 0, top], 0, top):
-            await bus.set_count(start)
-            model.write_count(start)
-            await env.settle(4)
-            await play_clocks(env, model, step_clocks(env.pos, BURST))
-            await env.settle(4)
+            await steps_from(env, model, start, BURST)
             await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
 
 
