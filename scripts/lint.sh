@@ -2,12 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 # Lint every module of the IP and of the board: Verilator --lint-only -Wall (with the reviewed
 # waivers in rtl/lint_waivers.vlt) and an Icarus -Wall build, at the defaults and at every corner
-# of every ranged parameter. The file lists and ranges come from enc_ip.core (tb/common/core_file.py);
+# of every ranged parameter. The file lists and ranges come from enc_ip.core (enctools.core);
 # boards/icebreaker/lint_params.txt adds the board's combined corners. Any warning fails the run.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$PWD/scripts/bin:$PWD/.venv/bin:$PATH"
-core() { .venv/bin/python tb/common/core_file.py "$@"; }
+core() { .venv/bin/python -m enctools.core "$@"; }
 
 mapfile -t ip_files < <(core files rtl)
 mapfile -t board_files < <(core files board_icebreaker)

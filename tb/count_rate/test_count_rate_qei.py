@@ -3,9 +3,9 @@
 
 import pytest
 
-from harness import run
+from enctools.harness import run
 
 
 @pytest.mark.parametrize("top", ["enc_qei_wb", "enc_qei_axil"])
 def test_count_rate_qei(top):
-    run(top, "qei_count_rate", name=f"count_rate_{top}", testcase="exact_at_bound,never_silent")
+    run(top, "enctools.benches.count_rate_qei", name=f"count_rate_{top}", testcase="exact_at_bound,never_silent")

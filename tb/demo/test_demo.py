@@ -11,13 +11,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-import harness
+from enctools import toolenv
 import pytest
 
 TOP = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(TOP / "scripts"))
-
-import demo  # noqa: E402  (scripts/demo.py; imports only the standard library at load time)
+from enctools import demo
 
 
 @pytest.mark.parametrize("kwargs, fragment", [
@@ -68,9 +66,9 @@ def test_bad_option_fails_before_building():
 
 def test_short_demo_run(tmp_path):
     """The whole demo at 20000 rpm (few clocks, Icarus): every verdict passes, the VCD parses."""
-    import vcd_to_png
+    from enctools import vcd_png as vcd_to_png
 
-    env = dict(os.environ, PATH=harness.tool_env_path())
+    env = dict(os.environ, PATH=toolenv.tool_path())
     png = tmp_path / "waves.png"
     r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", "20000",
                         "--sim", "icarus", "--name", "demo_test", "--png", str(png)],

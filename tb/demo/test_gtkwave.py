@@ -24,14 +24,13 @@ import sys
 import time
 from pathlib import Path
 
-import harness
+from enctools import toolenv
 import pytest
 
 TOP = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(TOP / "scripts"))
 
-import demo  # noqa: E402  (scripts/demo.py)
-import vcd_to_png  # noqa: E402  (its small VCD reader)
+from enctools import demo
+from enctools import vcd_png as vcd_to_png
 
 RPM = 20000                      # a short run: ~35k clocks, a few seconds on Icarus
 NAME = f"demo_gtkw_{os.getpid()}"
@@ -77,9 +76,9 @@ def short_run():
     and the bench's result (its start time t0)."""
     vcd = TOP / "sim" / "waves" / f"{NAME}.vcd"
     gtkw = vcd.with_suffix(".gtkw")
-    build = TOP / "sim" / "build" / "icarus" / NAME
+    build = TOP / "sim" / "build" / "icarus" / f"{NAME}-io"  # the demo's plan and result files
     try:
-        env = dict(os.environ, PATH=harness.tool_env_path())
+        env = dict(os.environ, PATH=toolenv.tool_path())
         t = time.monotonic()
         r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", str(RPM),
                             "--sim", "icarus", "--name", NAME, "--png", ""],

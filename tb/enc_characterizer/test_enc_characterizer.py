@@ -21,12 +21,12 @@ import numpy as np
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
 from cocotb.utils import get_sim_time
 
-import tbutil
-from harness import run
-from phase_models import (CLK_PS, DEG, Channels, characterizer_expect, cycles_of, figure3_degrees,
+from enctools import tb as tbutil
+from enctools.harness import run
+from enctools.tb.phase_models import (CLK_PS, DEG, Channels, characterizer_expect, cycles_of, figure3_degrees,
                           off_grid, sample_index, waveform)
 from cocotbext.quadrature import play
-from tbutil import log_seed
+from enctools.tb import cocotb_test, log_seed
 
 OUTPUTS = ("cycle_err", "pulse_err", "phase_err", "state_err", "state_min")
 ROOM_LIMIT = 46 * DEG  # 90 - 44 e-degrees: the note's room-temperature test limit
@@ -119,7 +119,7 @@ async def run_unit(dut, ch: Channels, cpc: float, forward: bool, what: str, jitt
 # ----------------------------------------------------------------------------------------------
 # Tests
 # ----------------------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def ideal_and_adjusted_units(dut):
     """An ideal unit, phase error, pulse-width error, both directions."""
     rng = random.Random(log_seed(dut))
@@ -143,7 +143,7 @@ async def ideal_and_adjusted_units(dut):
             assert abs(abs(got["state_err"] / DEG) - state) <= 1.5 * one
 
 
-@cocotb.test()
+@cocotb_test()
 async def jittered_units(dut):
     """Timing jitter on every edge: the extremes grow, both references still agree."""
     rng = random.Random(log_seed(dut))
@@ -154,7 +154,7 @@ async def jittered_units(dut):
                        f"jittered unit {k}", jitter_clocks=rng.uniform(2.0, 8.0), rng=rng)
 
 
-@cocotb.test()
+@cocotb_test()
 async def pass_flag_room_temperature_limit(dut):
     """pass = narrowest state >= min_state (46 e-degrees: 44 degrees of state-width error allowed)."""
     await start_clock(dut)
@@ -170,7 +170,7 @@ async def pass_flag_room_temperature_limit(dut):
     dut.min_state.value = ROOM_LIMIT
 
 
-@cocotb.test()
+@cocotb_test()
 async def reversal_abandons_window(dut):
     """A reversal in mid-window gives no mixed result: the next window starts after it."""
     await start_clock(dut)
@@ -193,7 +193,7 @@ async def reversal_abandons_window(dut):
     check(dut, results[0][1], exact, cont, "after reversal", CLK_PS / 1000.0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def slow_units_wide_states(dut):
     """A slow shaft: 2300 clocks per cycle, states of 450 to 750 clocks, so the upper bits of
     the state, pulse, phase and period registers carry data (the other tests run 150 to 400
@@ -214,7 +214,7 @@ async def slow_units_wide_states(dut):
         assert abs(abs(got["state_err"] / DEG) - state) <= 1.5 * one
 
 
-@cocotb.test()
+@cocotb_test()
 async def hedsmodel_units(dut):
     """Units drawn from the note's tables by the hedsmodel package, 600 rpm, clk 1 MHz (~200 clocks/cycle)."""
     from hedsmodel import EncoderUnit, Profile, measure
@@ -242,5 +242,5 @@ async def hedsmodel_units(dut):
 # pytest entry points
 # ----------------------------------------------------------------------------------------------
 def test_enc_characterizer():
-    run("enc_characterizer", "test_enc_characterizer", name="enc_characterizer_n32",
+    run("enc_characterizer", __name__, name="enc_characterizer_n32",
         parameters={"CNT_W": 12, "WINDOW_CYCLES": 32})

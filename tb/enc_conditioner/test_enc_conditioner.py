@@ -14,10 +14,12 @@ import pytest
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
-import tbutil
-from harness import run
-from models import ConditionerModel
+from enctools import tb as tbutil
+from enctools.harness import run
+from enctools.tb.models import ConditionerModel
 from cocotbext.quadrature import play
+
+from enctools.tb import cocotb_test
 from hedsmodel.waveform import Waveform, random_walk, with_glitches
 
 PERIOD_PS = 10_000
@@ -61,7 +63,7 @@ async def start(dut):
     return checker
 
 
-@cocotb.test()
+@cocotb_test()
 async def random_walk_with_glitches(dut):
     """5000 transitions with states from 0.5 T to 3F T, plus 500 lone pulses of 0.2 T .. (F+1) T."""
     f = int(dut.FILTER_LEN.value)
@@ -80,7 +82,7 @@ async def random_walk_with_glitches(dut):
         assert checker.glitches > 0, "short pulses were driven but no glitch was reported"
 
 
-@cocotb.test()
+@cocotb_test()
 async def short_pulses_rejected(dut):
     """Lone pulses shorter than FILTER_LEN samples never reach the outputs; each one that was
     sampled at all gives exactly one glitch pulse. (FILTER_LEN = 1 has no filter: every pulse that
@@ -124,7 +126,7 @@ async def short_pulses_rejected(dut):
     assert sampled > 20
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_mid_motion(dut):
     """rst for one clock at random times while both channels move."""
     f = int(dut.FILTER_LEN.value)
@@ -148,7 +150,7 @@ async def reset_mid_motion(dut):
     assert checker.clocks > 1000
 
 
-@cocotb.test()
+@cocotb_test()
 async def channels_keep_relative_timing(dut):
     """Edges on A and B at the same instant come out on the same clock; edges k clocks apart come
     out k clocks apart; the latency is 2 + FILTER_LEN clocks after the sampling edge."""
@@ -176,7 +178,7 @@ async def channels_keep_relative_timing(dut):
             assert latency == f + 1 + 0.25, f"{ch}: {latency} clocks from the edge to the output"
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_on_rejection_clock(dut):
     """A one-clock rst that falls exactly on the clock a short pulse is rejected: glitch must stay
     0 there (rst clears it), and the outputs follow the model after it. For each channel (and
@@ -215,5 +217,5 @@ async def reset_on_rejection_clock(dut):
 
 @pytest.mark.parametrize("filter_len", [1, 2, 3, 8])
 def test_enc_conditioner(filter_len):
-    run("enc_conditioner", "test_enc_conditioner", name=f"enc_conditioner_f{filter_len}",
+    run("enc_conditioner", __name__, name=f"enc_conditioner_f{filter_len}",
         parameters={"FILTER_LEN": filter_len})

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_phase_meter (Figure 11, the averaging phase meter) against the continuous waveform.
 
-The stimulus comes from tb/common/phase_models.py: waveforms computed from the shaft angle, edges at
+The stimulus comes from enctools.tb.phase_models: waveforms computed from the shaft angle, edges at
 real-valued times (never on the clock grid), optional pulse-width error, phase, timing jitter,
 stops and reversals. The expected reading is computed from the waveform, not from the RTL:
   - steady units: the true phase (between pulse centres = mean of rising- and falling-edge
@@ -24,14 +24,15 @@ import pytest
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
-import tbutil
-from harness import RTL, TOP, run
-from phase_models import (CLK_PS, Channels, off_grid, rises_of_a, sampled_meter_reading, steady,
-                          waveform, xor_phase)
+from enctools import tb as tbutil
+from enctools.harness import run
+from enctools.paths import RTL, TOP
+from enctools.tb.phase_models import (CLK_PS, LSB, Channels, Readings, off_grid, play_case, reset,
+                                      rises_of_a, sampled_meter_reading, start_clock, steady,
+                                      waveform, window_log2, xor_phase)
 from cocotbext.quadrature import play
-from tbutil import log_seed
+from enctools.tb import cocotb_test, log_seed
 
-LSB = 1.0 / 256.0  # degrees per phase_err LSB
 BOUND = 0.25  # contract accuracy, degrees
 worst = {"err": 0.0, "what": ""}
 
@@ -39,57 +40,6 @@ worst = {"err": 0.0, "what": ""}
 # ----------------------------------------------------------------------------------------------
 # Helpers
 # ----------------------------------------------------------------------------------------------
-def window_log2(dut) -> int:
-    return int(dut.WINDOW_LOG2.value)
-
-
-async def start_clock(dut):
-    await tbutil.start(dut, CLK_PS, {"a": 0, "b": 0}, do_reset=False)
-
-
-async def reset(dut, clocks: int = 2):
-    dut.rst.value = 1
-    for _ in range(clocks):
-        await FallingEdge(dut.clk)
-    dut.rst.value = 0
-
-
-class Readings:
-    """Collects (time_ps, phase_err degrees - as read -, a_leads, b_leads) on every valid pulse."""
-
-    def __init__(self, dut):
-        self.dut = dut
-        self.items = []
-        self.task = cocotb.start_soon(self._run())
-
-    async def _run(self):
-        while True:
-            await RisingEdge(self.dut.valid)
-            await ReadOnly()
-            self.items.append((get_sim_time("ps"), self.dut.phase_err.value.to_signed() * LSB,
-                               int(self.dut.a_leads.value), int(self.dut.b_leads.value)))
-            await RisingEdge(self.dut.clk)
-            await ReadOnly()
-            assert int(self.dut.valid.value) == 0, "valid is longer than one clock"
-
-    def stop(self):
-        self.task.cancel()
-
-
-async def play_case(dut, wf):
-    """Reset with the waveform's first levels on a/b (so the jump from the previous case's levels
-    is not an edge), then play ``wf`` from a falling clock edge; returns (readings, start_ps)."""
-    _, a0, b0 = wf.events[0]
-    dut.a.value, dut.b.value = a0, b0
-    await reset(dut)
-    start_ps = get_sim_time("ps")
-    rd = Readings(dut)
-    await play(dut, off_grid(wf, start_ps), "a", "b")
-    await FallingEdge(dut.clk)
-    rd.stop()
-    return rd.items, start_ps
-
-
 def note_error(err: float, what: str):
     if abs(err) > abs(worst["err"]):
         worst["err"], worst["what"] = err, what
@@ -140,7 +90,7 @@ def cycles_for(dut, clocks_per_cycle: float, windows: int) -> float:
 # ----------------------------------------------------------------------------------------------
 # Tests
 # ----------------------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def phase_sweep_both_directions(dut):
     """Phases from near 0 to near 180 e-degrees, forward and reverse, ~100..130 clocks/cycle."""
     rng = random.Random(log_seed(dut))
@@ -158,7 +108,7 @@ async def phase_sweep_both_directions(dut):
             check_reading(dut, items[0], ch.true_phase, forward, what)
 
 
-@cocotb.test()
+@cocotb_test()
 async def zero_reading_at_90(dut):
     """An encoder adjusted to 90 degrees reads zero (within the contract bound)."""
     rng = random.Random(log_seed(dut))
@@ -171,7 +121,7 @@ async def zero_reading_at_90(dut):
             check_reading(dut, r, 90.0, True, f"90 deg at {cpc:.2f} clk/cycle, reading {i}")
 
 
-@cocotb.test()
+@cocotb_test()
 async def pulse_width_error_reads_mean_of_edges(dut):
     """With pulse-width error the reading is the mean of the rising- and falling-edge phases."""
     await start_clock(dut)
@@ -196,7 +146,7 @@ async def pulse_width_error_reads_mean_of_edges(dut):
                 assert abs(items[0][1] - (rise - 90.0)) > 1.0, f"{what}: reads the rising edges only"
 
 
-@cocotb.test()
+@cocotb_test()
 async def jittered_edges(dut):
     """Edge jitter: the reading matches an ideal averaging meter on the same whole cycles."""
     rng = random.Random(log_seed(dut))
@@ -231,7 +181,7 @@ async def jittered_edges(dut):
                           bound=0.5)
 
 
-@cocotb.test()
+@cocotb_test()
 async def random_units(dut):
     """Random steady units (>= 100 clocks/cycle, >= 64 cycles/window): the contract bound."""
     rng = random.Random(log_seed(dut))
@@ -258,7 +208,7 @@ async def random_units(dut):
     dut._log.info("worst |error| in this build: %.4f deg (%s)", abs(worst["err"]), worst["what"])
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_mid_window(dut):
     """rst in mid-window: LEDs back to 0, the window is abandoned, the next reading is clean."""
     await start_clock(dut)
@@ -301,7 +251,7 @@ async def reset_mid_window(dut):
         check_reading(dut, r, ch.true_phase, True, "reset mid-window")
 
 
-@cocotb.test()
+@cocotb_test()
 async def direction_change_mid_window(dut):
     """Reverse in mid-window: the LEDs swap, the mixed window gives no reading, later ones are right."""
     await start_clock(dut)
@@ -327,7 +277,7 @@ async def direction_change_mid_window(dut):
             check_reading(dut, r, ch.true_phase, not first_fwd, "after reversal")
 
 
-@cocotb.test()
+@cocotb_test()
 async def standing_shaft_no_reading(dut):
     """No whole cycle in a window (standing, or slower than one cycle per window): no reading."""
     await start_clock(dut)
@@ -346,7 +296,7 @@ async def standing_shaft_no_reading(dut):
     assert items == [], f"readings with {slow} clocks per cycle: {items}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def reading_cadence(dut):
     """Readings come once per window: 2^W clocks + at most one cycle + the divider."""
     await start_clock(dut)
@@ -362,7 +312,7 @@ async def reading_cadence(dut):
         check_reading(dut, r, 100.0, True, "cadence")
 
 
-@cocotb.test()
+@cocotb_test()
 async def commensurate_speed(dut):
     """Not asynchronous: a whole or half-integer number of clocks per cycle samples every edge at
     the same one or two clock phases. The reading is then off by the sampling error of one cycle,
@@ -380,7 +330,7 @@ async def commensurate_speed(dut):
         assert abs(err) <= 2 * 180.0 / cpc
 
 
-@cocotb.test()
+@cocotb_test()
 async def frequency_case(dut):
     """One encoder speed chosen by the pytest entry (ENC_PHASE_CPC clocks/cycle): phases both ways."""
     rng = random.Random(log_seed(dut))
@@ -399,77 +349,6 @@ async def frequency_case(dut):
     dut._log.info("worst |error| in this build: %.4f deg (%s)", abs(worst["err"]), worst["what"])
 
 
-def adjust_waveform(cpc: float, phase_at, cycles: int, forward: bool, pulse_err=(6.0, -4.0),
-                    t0_ns: float = 0.0):
-    """A unit whose rise phase follows ``phase_at(k)`` (cycle k), i.e. the encoder body being
-    turned while the shaft runs. Returns the waveform (events off the clock grid)."""
-    from hedsmodel.waveform import Waveform
-    period = cpc * CLK_PS / 1000.0
-    pa, pb = pulse_err
-    edges = []  # (t, channel, level)
-    for k in range(cycles):
-        ph = phase_at(k)
-        # forward: A rise at 0, B rise at ph, A fall at 180 + pa, B fall at ph + 180 + pb (degrees
-        # of this cycle); reverse plays the same angles backwards
-        for ang, chan, lvl in ((0.0, 0, 1), (ph, 1, 1), (180.0 + pa, 0, 0), (ph + 180.0 + pb, 1, 0)):
-            if forward:
-                edges.append((t0_ns + (k + ang / 360.0) * period, chan, lvl))
-            else:
-                edges.append((t0_ns + (k + 1 - ang / 360.0) * period, chan, 1 - lvl))
-    edges.sort()
-    a, b = (0, 0) if forward else (0, 0)
-    wf = Waveform()
-    wf.append(t0_ns, None, (a, b))
-    for t, chan, lvl in edges:
-        if chan == 0:
-            a = lvl
-        else:
-            b = lvl
-        wf.append(max(t, wf.events[-1][0]), None, (a, b))
-    return wf
-
-
-@cocotb.test()
-async def phase_adjust_sweep(dut):
-    """scripts/phase_adjust.py: the technician turns the encoder body so that the phase moves
-    slowly from 60 to 120 e-degrees (between the pulse centres) while the shaft runs forward, then runs the shaft in reverse
-    at the 90 degree setting. Writes the readings and the true phases to $ENC_PHASE_ADJUST_OUT."""
-    import json
-
-    await start_clock(dut)
-    w = 2 ** window_log2(dut)
-    cpc = 109.618034
-    per_window = w / cpc
-    n_fwd = int(float(os.environ.get("ENC_PHASE_ADJUST_READINGS", "25")) * (per_window + 1.5))
-    # rise phase such that the phase between pulse centres (what the meter reads) runs 60 -> 120
-    phase_fwd = lambda k: 65.0 + 60.0 * k / n_fwd  # noqa: E731
-    wf = adjust_waveform(cpc, phase_fwd, n_fwd, True)
-    t_end = wf.events[-1][0]
-    n_rev = int(2 * (per_window + 1.5)) + 2
-    wf_rev = adjust_waveform(cpc, lambda k: 95.0, n_rev, False, t0_ns=t_end)
-    wf.events += wf_rev.events[1:]
-    wf.positions += wf_rev.positions[1:]
-    items, start_ps = await play_case(dut, wf)
-    period_ns = cpc * CLK_PS / 1000.0
-    rows = []
-    for t_ps, perr, a_l, b_l in items:
-        t_ns = (t_ps - start_ps) / 1000.0
-        # the window: 2^W clocks ending W + 18 clocks before the reading; its true phase is the
-        # mean of the per-cycle phases (centres) over it
-        t1 = t_ns - (window_log2(dut) + 18) * CLK_PS / 1000.0
-        t0 = t1 - w * CLK_PS / 1000.0
-        if t1 <= t_end:
-            ks = [k for k in range(n_fwd) if t0 <= k * period_ns < t1]
-            true = sum(phase_fwd(k) for k in ks) / len(ks) + (-4.0 - 6.0) / 2.0
-        else:
-            true = 95.0 + (-4.0 - 6.0) / 2.0
-        rows.append({"t_ms": t_ns / 1e6, "phase_err": perr, "true_err": true - 90.0,
-                     "a_leads": a_l, "b_leads": b_l, "forward": t1 <= t_end})
-    with open(os.environ["ENC_PHASE_ADJUST_OUT"], "w") as f:
-        json.dump({"window_log2": window_log2(dut), "clocks_per_cycle": cpc, "clk_ns": CLK_PS / 1000,
-                   "readings": rows}, f, indent=1)
-
-
 # ----------------------------------------------------------------------------------------------
 # pytest entry points
 # ----------------------------------------------------------------------------------------------
@@ -480,7 +359,7 @@ MAIN_TESTS = ("phase_sweep_both_directions,zero_reading_at_90,pulse_width_error_
 
 def test_enc_phase_meter():
     """The behaviour tests at WINDOW_LOG2 = 13 (8192 clocks: 64+ cycles of 100..128 clocks)."""
-    run("enc_phase_meter", "test_enc_phase_meter", name="enc_phase_meter_w13",
+    run("enc_phase_meter", __name__, name="enc_phase_meter_w13",
         parameters={"WINDOW_LOG2": 13}, testcase=MAIN_TESTS)
 
 
@@ -490,7 +369,7 @@ def test_enc_phase_meter_speed(log2, cpc, cases):
     directions) and 10000 at WINDOW_LOG2 = 17 (13 cycles: fewer than the contract's 64, but each
     cycle's sampling error is 100 times smaller; a 64-cycle window would be a million clocks, too
     slow for Icarus), each held to the 0.25 degree bound."""
-    run("enc_phase_meter", "test_enc_phase_meter", name=f"enc_phase_meter_w{log2}",
+    run("enc_phase_meter", __name__, name=f"enc_phase_meter_w{log2}",
         parameters={"WINDOW_LOG2": log2}, testcase="frequency_case",
         extra_env={"ENC_PHASE_CPC": str(cpc), "ENC_PHASE_CASES": str(cases)})
 

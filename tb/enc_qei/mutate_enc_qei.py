@@ -10,9 +10,9 @@ first failure.
 
 import pytest
 
-from core_file import rtl_files
-from harness import TOP, run
-from qei_tb import QEI_RTL
+from enctools.core import rtl_files
+from enctools.harness import TOP, run
+from enctools.qei.bus import QEI_RTL
 
 
 def extra_sources() -> tuple:

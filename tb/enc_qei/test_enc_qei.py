@@ -18,10 +18,10 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from cocotbext.quadrature import QuadratureDriver
 from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
 
-from harness import run
-from qei_model import FUNCS, RANGES, QeiModel
-from qei_tb import PERIOD_PS, T_NS, QeiBus, event_bits, extra_sources, pack, regmap, size_mask
-from tbutil import start
+from enctools.harness import run
+from enctools.qei.model import FUNCS, RANGES, QeiModel
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, event_bits, pack, regmap, size_mask
+from enctools.tb import cocotb_test, start
 
 FILTER = 2  # FILTER_LEN for the walks; states last >= 1.05 FILTER clocks
 
@@ -105,7 +105,7 @@ async def begin(dut):
 
 
 # ---- tests --------------------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def func_walks(dut):
     """Every CTRL.FUNC against the model: long random walks, dither, illegal jumps."""
     env, rng = await begin(dut)
@@ -127,7 +127,7 @@ async def func_walks(dut):
         dut._log.info("%s: count %#x, %d quadrature errors", func, model.count, qerr)
 
 
-@cocotb.test()
+@cocotb_test()
 async def range_modes(dut):
     """Each RANGE across its boundaries, both ways; non_recycle stops until COUNT is written."""
     env, rng = await begin(dut)
@@ -158,7 +158,7 @@ async def range_modes(dut):
         dut._log.info("%s ok (ceiling %d)", mode, ceiling)
 
 
-@cocotb.test()
+@cocotb_test()
 async def coherent_64bit(dut):
     """COUNT_LO then COUNT_HI is one value while the count carries across bit 32 between them."""
     env, rng = await begin(dut)
@@ -205,7 +205,7 @@ def z_window(lo, hi):
     return lambda p: int(lo <= p <= hi)
 
 
-@cocotb.test()
+@cocotb_test()
 async def index(dut):
     """INDEX_CTRL: preset / latch / none, gate, one-shot, rising and falling, forward and back."""
     env, rng = await begin(dut)
@@ -252,7 +252,7 @@ async def index(dut):
     model.idx_action = "none"
 
 
-@cocotb.test()
+@cocotb_test()
 async def index_gate_same_position(dut):
     """With the gate, a preset index gives the same position forward and backward."""
     env, rng = await begin(dut)
@@ -274,7 +274,7 @@ async def index_gate_same_position(dut):
         assert got == 500 + (target - 6), f"direction {direction}: count {got}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def probe(dut):
     """PROBE_CTRL: the count and the timebase at the chosen edge; ONCE clears EN."""
     env, rng = await begin(dut)
@@ -309,7 +309,7 @@ async def probe(dut):
     await bus.wr("PROBE_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def compare(dut):
     """COMPARE: the CMP event and one cmp_out pulse each time the count changes to it."""
     env, rng = await begin(dut)
@@ -341,7 +341,7 @@ async def compare(dut):
     assert pulses >= 2, "the walk never reached COMPARE"
 
 
-@cocotb.test()
+@cocotb_test()
 async def events_and_irq(dut):
     """Every count-side event: set, masked, enabled onto irq, cleared alone by W1C."""
     env, rng = await begin(dut)
@@ -423,7 +423,7 @@ async def events_and_irq(dut):
     assert await bus.rd("GLITCH_COUNT") >= 1
 
 
-@cocotb.test()
+@cocotb_test()
 async def unmapped_offsets(dut):
     """Unmapped offsets: read 0 with an error, write nothing with an error, never hang."""
     env, rng = await begin(dut)
@@ -451,7 +451,7 @@ def addr_of(name):
     return regmap()[name].offset
 
 
-@cocotb.test()
+@cocotb_test()
 async def byte_enables(dut):
     """Writes honour the byte enables: storage, the count, and W1C events."""
     env, rng = await begin(dut)
@@ -482,7 +482,7 @@ async def byte_enables(dut):
     assert await bus.rd("EVENTS") == word & ~0xFF00
 
 
-@cocotb.test()
+@cocotb_test()
 async def filter_lengths(dut):
     """Run-time FILTER_LEN: exact counting at the rate rule, lone pulses rejected and counted."""
     env, rng = await begin(dut)
@@ -520,7 +520,7 @@ async def filter_lengths(dut):
         model.take_events()
 
 
-@cocotb.test()
+@cocotb_test()
 async def heds_unit_profile(dut):
     """A modelled HEDS-5000 unit (typical errors) accelerating, reversing and stopping: x4 count
     equals the model's position, no error flagged. Clock 2 MHz, so states last >= 10 clocks."""
@@ -562,7 +562,7 @@ async def heds_unit_profile(dut):
                   got if got < 1 << 31 else got - (1 << env.count_w))
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_mid_motion(dut):
     """rst while the shaft turns: every register back to reset; then counts from the new reference."""
     env, rng = await begin(dut)
@@ -592,7 +592,7 @@ async def reset_mid_motion(dut):
         got = await bus.rd(name)
         mask = 0
         for f in reg.fields.values():
-            from qei_tb import size_mask
+            from enctools.regmap import size_mask
             mask |= (size_mask(f.sized_by, env.count_w, int(dut.TS_W.value)) << f.lsb) & f.mask \
                 if f.reset is not None else 0
         assert got & mask == exp & mask, f"{name} after rst: {got:#x}, reset {exp & mask:#x}"
@@ -605,7 +605,7 @@ async def reset_mid_motion(dut):
     assert await bus.count() == (c0 + model2.count) & model2.max
 
 
-@cocotb.test()
+@cocotb_test()
 async def register_walk(dut):
     """Every register of the compiled RDL through the bus: offset, reset value, access."""
     env, rng = await begin(dut)
@@ -661,7 +661,7 @@ async def register_walk(dut):
     await bus.events()
 
 
-@cocotb.test()
+@cocotb_test()
 async def beyond_rate_rule(dut):
     """Outside the count-rate rule (states shorter than a clock, pulses shorter than the filter)
     the count is exact or QERR / GLITCH is raised: never a silent loss."""
@@ -740,7 +740,7 @@ def s32(v):
     return v - (1 << 32) if v >> 31 else v
 
 
-@cocotb.test()
+@cocotb_test()
 async def snapshot_coherence(dut):
     """Snapshots by bus command, snap_in and the unit timer while the shaft turns: SNAP_COUNT,
     SNAP_TIME, SNAP_EDGE_TIME and SNAP_DELTA all belong to one clock."""
@@ -804,7 +804,7 @@ async def snapshot_coherence(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def snapshot_deltas_across_wraps(dut):
     """SNAP_DELTA counts applied steps across modulo wraps and limits; SNAP_EDGE_DELTA is the
     count change between the last selected edges (any edge, and A rising with x4 counting)."""
@@ -848,7 +848,7 @@ async def snapshot_deltas_across_wraps(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def prescaler_and_snap_in(dut):
     """TIMEBASE advances once every PRESCALE + 1 clocks: snap_in rising edges G clocks apart give
     SNAP_TIME values G / (PRESCALE + 1) apart (floor or ceiling); snap_in held high snaps once."""
@@ -897,7 +897,7 @@ async def prescaler_and_snap_in(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def period_capture(dut):
     """PERIOD over N edges at constant speed, the direction-change flag, PERIOD_READY, and the
     overflow flag and PERIOD_OVF event (TS_W = 16 builds only: 65,536 ticks)."""
@@ -946,7 +946,7 @@ async def period_capture(dut):
     await bus.wr("PERIOD_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def stall_and_recovery(dut):
     """STALL_TIMEOUT: the stall event and STATUS.STALLED after that many ticks without a count
     edge, not before; cleared by the next edge; once per stop."""
@@ -981,5 +981,5 @@ CONFIGS = [("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16)]
 
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=[f"{t}-c{c}-t{s}" for t, c, s in CONFIGS])
 def test_enc_qei(top, count_w, ts_w):
-    run(top, "test_enc_qei", name=f"{top}_c{count_w}_t{ts_w}",
-        parameters={"COUNT_W": count_w, "TS_W": ts_w}, extra_sources=extra_sources())
+    run(top, __name__, name=f"{top}_c{count_w}_t{ts_w}",
+        parameters={"COUNT_W": count_w, "TS_W": ts_w})

@@ -16,10 +16,12 @@ import pytest
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 
-from harness import run
+from enctools.tb import cocotb_test
+
+from enctools.harness import run
 from hedsmodel import QUAD, random_walk, walk, with_glitches
-from qei_model import QeiModel
-from qei_tb import (PERIOD_PS, T_NS, event_bits, extra_sources, pack, play_clocks, regmap, size_mask,
+from enctools.qei.model import QeiModel
+from enctools.qei.bus import (PERIOD_PS, T_NS, event_bits, pack, play_clocks, regmap, size_mask,
                     step_clocks)
 from test_enc_qei import begin, durations
 
@@ -30,7 +32,7 @@ def _field(reg, name, word):
 
 
 # ---- timing unit -----------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def unit_timer_period(dut):
     """SNAP_PERIOD = P: the unit timer snaps every P ticks (0 and 1: every tick), at PRESCALE 0
     and 1: SNAP_TIME values read 2.5 periods apart differ by a multiple of P, and SNAP_TIME is never
@@ -59,7 +61,7 @@ async def unit_timer_period(dut):
     await bus.wr("TB_PRESCALE", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def period_large_n(dut):
     """PERIOD_CTRL.N up to 255: PERIOD = N x the edge interval (any edge, states of 3 clocks)."""
     env, rng = await begin(dut)
@@ -75,7 +77,7 @@ async def period_large_n(dut):
         await bus.wr("PERIOD_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def snapshot_wide_values(dut):
     """SNAP_COUNT of counts with every bit pattern (the high half too): a snapshot holds them;
     SNAP_TIME and SNAP_EDGE_TIME of an edge taken 4,200 to 12,600 clocks after reset (timebase
@@ -108,7 +110,7 @@ async def snapshot_wide_values(dut):
             f"TIMEBASE {before:#x}, SNAP_EDGE_TIME {t_edge:#x}, SNAP_TIME {t_snap:#x}, TIMEBASE {after:#x}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def stall_timeout_exact(dut):
     """The stall comes exactly STALL_TIMEOUT ticks after the last step: the clocks from a step to
     irq (IRQ_EN = STALL) differ between two timeouts by exactly their difference (PRESCALE 0), or
@@ -149,7 +151,7 @@ async def stall_timeout_exact(dut):
     await bus.events()
 
 
-@cocotb.test()
+@cocotb_test()
 async def prescaler_long(dut):
     """TIMEBASE at PRESCALE values that set bits 0 .. 8, over 8 to 150 ticks (2,400 clocks or
     more): snap_in rising edges G clocks apart give SNAP_TIME values G / (PRESCALE + 1) apart
@@ -183,7 +185,7 @@ async def prescaler_long(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def error_counters_wide(dut):
     """QERR_COUNT and GLITCH_COUNT past 1,024 (bits 10 and up): 1,100 illegal jumps and 1,100
     lone one-clock pulses are each counted."""
@@ -212,7 +214,7 @@ async def error_counters_wide(dut):
 
 
 # ---- conditioner (enc_conditioner_rt) -------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def filter_len_clamp(dut):
     """CTRL.FILTER_LEN 0 acts as 1 (states of 1.05 clocks count exactly), 31 as 16 (a level of
     14.7 clocks is rejected, states of 17.5 .. 70 clocks count exactly)."""
@@ -253,7 +255,7 @@ async def pulse_rst(dut, clocks=1):
     dut.rst.value = 0
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_in_each_state(dut):
     """rst with the shaft standing in each of the four states (inputs held through the reset):
     the peripheral takes that state as its reference: count 0, no QERR, no GLITCH; then it counts
@@ -278,7 +280,7 @@ async def reset_in_each_state(dut):
         assert await bus.count() == model.count, f"state {a}{b}: count after rst"
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_on_rejection_clock(dut):
     """A one-clock rst at every clock around the rejection of a lone 2-clock pulse (FILTER_LEN 3,
     the reset value): the reset clears the pending rejection, no GLITCH afterwards."""
@@ -298,7 +300,7 @@ async def reset_on_rejection_clock(dut):
         assert await bus.rd("GLITCH_COUNT") == 0
 
 
-@cocotb.test()
+@cocotb_test()
 async def step_soon_after_reset(dut):
     """A step whose conditioned level arrives a few clocks after `valid` rose (FILTER_LEN 3, the
     reset value: the input changes between the 2nd and 3rd rising edge after rst falls) is
@@ -323,7 +325,7 @@ async def step_soon_after_reset(dut):
 
 
 # ---- core: channel options -------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def swap_and_invert(dut):
     """CTRL.SWAP_AB, INV_A, INV_B, INV_Z in every combination: STATUS.A/B/Z show the channels as
     the decoders see them, and a forward walk counts up or down by the parity of the three A/B
@@ -358,7 +360,7 @@ async def swap_and_invert(dut):
 WIDE = (0x5A5A_A5A5_C3C3_3C3C, 0xA5A5_5A5A_3C3C_C3C3, 0x8000_0001_8000_0001, 0x7FFE_FFFF_0FF0_F00F)
 
 
-@cocotb.test()
+@cocotb_test()
 async def latches_wide(dut):
     """PROBE_LATCH and INDEX_LATCH of counts with every bit pattern (the high word too)."""
     env, rng = await begin(dut)
@@ -385,7 +387,7 @@ async def latches_wide(dut):
         await bus.wr("INDEX_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def ceiling_wide(dut):
     """RANGE modulo and limit with CEILINGs of varied bit patterns: across the top both ways, and
     from counts just above and below it in each 16-bit slice (the slices are compared apart)."""
@@ -409,7 +411,7 @@ async def ceiling_wide(dut):
                 await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}")
 
 
-@cocotb.test()
+@cocotb_test()
 async def bounded_range_fast(dut):
     """RANGE modulo and limit at the count-rate bound (FILTER_LEN 1, states of 1.05 .. 2.1 clocks,
     many reversals: steps in consecutive clocks both ways), CEILINGs with high bits, counts on
@@ -476,7 +478,7 @@ async def steps_from(env, model, start, steps):
     await env.settle(4)
 
 
-@cocotb.test()
+@cocotb_test()
 async def steps_in_consecutive_clocks(dut):
     """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
     and just below CEILING, at 0 and at the top, steps in consecutive clocks both ways (an up step
@@ -503,7 +505,7 @@ def _pair_ceilings(count_w):
     return [0, 1, 0x8000_8021]
 
 
-@cocotb.test()
+@cocotb_test()
 async def step_pairs_at_bounds(dut):
     """Two steps in consecutive clocks (down-up, up-down, up-up) from counts at, just above and
     just below CEILING and at 0 / 1, every bounded range, CEILING 0 and 1 too: COUNT, EVENTS and
@@ -525,7 +527,7 @@ async def step_pairs_at_bounds(dut):
                     assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def steps_at_patterned_ceilings(dut):
     """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
     list every run), each range, counts one step and one or five units of a 16-bit slice away:
@@ -548,7 +550,7 @@ async def steps_at_patterned_ceilings(dut):
             await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
 
 
-@cocotb.test()
+@cocotb_test()
 async def free_range_ignores_ceiling(dut):
     """RANGE free with CEILING set below the top (free ignores it): steps in consecutive clocks
     across CEILING, and at 0 and the top: COUNT and EVENTS as the model's (no wrap at CEILING)."""
@@ -562,7 +564,7 @@ async def free_range_ignores_ceiling(dut):
             await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
 
 
-@cocotb.test()
+@cocotb_test()
 async def index_gate_each_state(dut):
     """INDEX_CTRL gate (GATE_EN, GATE_A, GATE_B) at each of the four states, a Z pulse in each
     state: the INDEX event and the latch only for the gate's state (model's index qualifier)."""
@@ -588,7 +590,7 @@ async def index_gate_each_state(dut):
     await bus.wr("INDEX_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def index_at_steps(dut):
     """An index preset in the clock right before steps in consecutive clocks (PRESET at, just above
     and just below CEILING, also in another 16-bit slice), and an index latch in the very clock of
@@ -647,7 +649,7 @@ async def index_at_steps(dut):
                 model.idx_action = "none"
 
 
-@cocotb.test()
+@cocotb_test()
 async def unit_timer_prescaled(dut):
     """The unit timer at PRESCALE 2 .. 5 (ticks 3 .. 6 clocks apart: clocks without a tick between
     the ticks): SNAP_PERIOD = P gives a SNAP_READY exactly P x (PRESCALE + 1) clocks after the
@@ -682,7 +684,7 @@ async def unit_timer_prescaled(dut):
     await bus.events()
 
 
-@cocotb.test()
+@cocotb_test()
 async def snapshot_deltas_held(dut):
     """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
     an odd and an even number of clocks apart, after walks forward, back and turning between two
@@ -722,7 +724,7 @@ async def snapshot_deltas_held(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def period_above_2k_ticks(dut):
     """PERIOD of edge intervals of 2,652 ticks (bits 2 .. 11 in the tick counter and PERIOD; the
     other tests measure 765 ticks at most, or the 2^16 overflow at TS_W 16): exact, and held
@@ -752,7 +754,7 @@ async def period_above_2k_ticks(dut):
     await bus.wr("PERIOD_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def period_consecutive_edges(dut):
     """PERIOD_CTRL.N 2 .. 17 with an edge in every clock (FILTER_LEN 1, one state per clock: the
     edge after a measurement's start edge, and the one after the next-to-last, come in the very
@@ -770,7 +772,7 @@ async def period_consecutive_edges(dut):
         await bus.wr("PERIOD_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def period_held_after_disable(dut):
     """PERIOD keeps the last measurement after PERIOD_CTRL.EN is cleared: a period of 0x2A5C ticks
     (bit 13 set, within TS_W 16), read an odd and an even number of clocks apart, before and after
@@ -792,7 +794,7 @@ async def period_held_after_disable(dut):
                 await ClockCycles(dut.clk, gap)
 
 
-@cocotb.test()
+@cocotb_test()
 async def snapshot_edge_delta_after_reversal(dut):
     """SNAP_CTRL.EDGE = A rising: a snapshot taken after steps back behind the last rising edge of
     A (steps counted since that edge go down from a positive value), then walks forward through
@@ -822,7 +824,7 @@ async def snapshot_edge_delta_after_reversal(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def one_clock_reset_in_motion(dut):
     """A reset of one clock in each clock around an applied down step (and up step): afterwards
     SNAP_DELTA (a snapshot by command, the shaft still) is 0 and COUNT is 0 -- nothing of the
@@ -867,7 +869,7 @@ def _cfg_fields(r):
     return sum(f.mask for f in r.fields.values() if f.kind == "cfg")
 
 
-@cocotb.test()
+@cocotb_test()
 async def register_patterns(dut):
     """Every storage register written with its own pattern, then all read back (no write lands in
     another register, no read shows another one), twice with the patterns complemented, each read
@@ -895,7 +897,7 @@ async def register_patterns(dut):
     await bus.events()
 
 
-@cocotb.test()
+@cocotb_test()
 async def byte_enables_all(dut):
     """Every storage register and COUNT_HI honour each byte-enable mask (contiguous lanes on
     AXI4-Lite): the lanes written take the new bytes, the others keep theirs."""
@@ -933,7 +935,7 @@ async def byte_enables_all(dut):
         assert got == exp, f"COUNT_HI strb {strb:#x}: count {got:#x}, expected {exp:#x}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def probe_time_exact(dut):
     """PROBE_TIME at probe edges spread over the timebase's low bits: within the TIMEBASE values
     read just before and just after, and PROBE_LATCH the count, every time."""
@@ -993,7 +995,7 @@ async def concurrent_reads_and_writes(dut):
         await bus.wr(r, 0)
 
 
-@cocotb.test()
+@cocotb_test()
 async def irq_low_in_reset(dut):
     """irq is 0 in every clock of a reset and after it, even with events pending and enabled
     when rst comes."""
@@ -1015,7 +1017,7 @@ async def irq_low_in_reset(dut):
         assert dut.irq.value == 0, f"irq high {k} clocks after the reset"
 
 
-@cocotb.test()
+@cocotb_test()
 async def wb_abandoned_cycle(dut):
     """Wishbone: a cycle the master drops (CYC low) before the answer gets no ACK or ERR
     outside it (a mapped and an unmapped offset); the next cycle works. (AXI4-Lite has no such case: nothing to do.)"""
@@ -1051,5 +1053,5 @@ CONFIGS = [("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16)]
 
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=[f"{t}-c{c}-t{s}" for t, c, s in CONFIGS])
 def test_enc_qei_gaps(top, count_w, ts_w):
-    run(top, "test_enc_qei_gaps", name=f"gaps_{top}_c{count_w}_t{ts_w}",
-        parameters={"COUNT_W": count_w, "TS_W": ts_w}, extra_sources=extra_sources())
+    run(top, __name__, name=f"gaps_{top}_c{count_w}_t{ts_w}",
+        parameters={"COUNT_W": count_w, "TS_W": ts_w})

@@ -12,8 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from harness import sim_name
-from qei_tb import extra_sources
+from enctools.harness import sim_name
 
 TOP = Path(__file__).resolve().parents[2]
 
@@ -28,8 +27,8 @@ CASES += [("enc_conditioner_rt", "MAX_FILTER_LEN", v, ok)
 
 
 def sources() -> list[str]:
-    from harness import rtl_sources
-    return [str(p) for p in list(rtl_sources()) + list(extra_sources())]
+    from enctools.harness import rtl_sources
+    return [str(p) for p in list(rtl_sources())]
 
 
 def elaborate(top, param, value, tool):

@@ -13,9 +13,8 @@ from pathlib import Path
 
 import pytest
 
-TOP = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(TOP / "scripts"))
-import gen_regs  # noqa: E402
+from enctools.gen import regs as gen_regs
+from enctools.paths import TOP
 
 
 def test_generated_outputs_are_current():

@@ -36,9 +36,8 @@ needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc not installed")
 @lru_cache(maxsize=None)
 def rdl():
     """{register: {field: (lsb, width, {member: value} or None)}} from the compiled RDL (the same
-    compile as scripts/gen_regs.py)."""
-    sys.path.insert(0, str(TOP / "scripts"))
-    from gen_regs import compile_rdl
+    compile as the generators: enctools.regmap)."""
+    from enctools.regmap import compile_rdl
 
     out = {}
     for r in compile_rdl().registers():

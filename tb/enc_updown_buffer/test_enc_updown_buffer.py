@@ -13,12 +13,12 @@ import cocotb
 import pytest
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 
-import tbutil
-from harness import run
-from models import two_x_count
+from enctools import tb as tbutil
+from enctools.harness import run
+from enctools.tb.models import two_x_count
 from cocotbext.quadrature import play
 from hedsmodel.waveform import random_walk, walk
-from tbutil import reset_dut
+from enctools.tb import cocotb_test, reset_dut
 
 PERIOD_PS = 10_000
 T_NS = PERIOD_PS / 1000
@@ -66,7 +66,7 @@ def state_range_ns(buf):
     return s, 2 * s
 
 
-@cocotb.test()
+@cocotb_test()
 async def random_walk_20k(dut):
     """20,000 transitions (edges off the clock grid) in 20 segments; after each the count and
     rd_data equal the true 2X position modulo MODULUS**DIGITS, and no flag fired."""
@@ -101,7 +101,7 @@ class FlagCounter:
             self.rco += int(self.dut.rco_n.value) == 0
 
 
-@cocotb.test()
+@cocotb_test()
 async def wraps_both_ways(dut):
     """Oscillate across zero: below zero the count wraps to the top, above the top back to zero.
     rco_n is low on exactly the counts that wrap."""
@@ -134,7 +134,7 @@ async def wraps_both_ways(dut):
     assert buf.count() == buf.expect(0, -3) == buf.span - 1, f"count {buf.count()} below zero"
 
 
-@cocotb.test()
+@cocotb_test()
 async def hold_freezes_rd_data(dut):
     """While hold = 1, rd_data stays put as the count moves; within 2 clocks of hold falling it
     shows the count again."""
@@ -170,7 +170,7 @@ async def hold_freezes_rd_data(dut):
         assert buf.rd() == buf.count(), f"trial {trial}: rd_data did not catch up within 2 clocks"
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_mid_motion(dut):
     """rst while the shaft moves clears the count; counting resumes from the new reference."""
     buf = await start(dut)
@@ -199,7 +199,7 @@ async def reset_mid_motion(dut):
         pos = wf.final_position
 
 
-@cocotb.test()
+@cocotb_test()
 async def illegal_jumps_flagged(dut):
     """Both channels flipping at the same instant (an illegal transition, two states at once):
     every jump that moves A pulses `error`, so the count is never wrong silently."""
@@ -224,7 +224,7 @@ async def illegal_jumps_flagged(dut):
     assert flags.glitch == 0
 
 
-@cocotb.test()
+@cocotb_test()
 async def rd_data_at_the_top(dut):
     """Below zero every digit is MODULUS-1, so the high bits of every digit are set: count AND
     rd_data read the wrapped value at each stop of a walk across zero; then hold freezes rd_data at
@@ -261,7 +261,7 @@ async def rd_data_at_the_top(dut):
     assert buf.rd() == buf.count() == buf.expect(0, pos), "rd_data did not catch up after hold"
 
 
-@cocotb.test()
+@cocotb_test()
 async def glitch_reaches_output(dut):
     """A one-sample pulse on a_in or b_in is rejected by the conditioner (FILTER_LEN > 1): one
     `glitch` pulse at the buffer's output each, no count, no error. With FILTER_LEN = 1 the pulse
@@ -295,6 +295,6 @@ CONFIGS = [  # (DIGITS, MODULUS, FILTER_LEN)
 
 @pytest.mark.parametrize("digits,modulus,filter_len", CONFIGS)
 def test_enc_updown_buffer(digits, modulus, filter_len):
-    run("enc_updown_buffer", "test_enc_updown_buffer",
+    run("enc_updown_buffer", __name__,
         name=f"enc_updown_buffer_d{digits}_m{modulus}_f{filter_len}",
         parameters={"DIGITS": digits, "MODULUS": modulus, "FILTER_LEN": filter_len})

@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""enc_x2_xor (Figure 15, the 2X XOR decoder) against its model in tb/common/models.py, clock by clock. The cocotb tests are
-shared by the three decoders: tb/common/decoder_bench.py."""
+"""enc_x2_xor (Figure 15, the 2X XOR decoder) against its model in enctools.tb.models, clock by clock. The cocotb tests are
+shared by the three decoders: enctools.tb.decoder_bench."""
 
-from decoder_bench import COMMON_TESTS
-from harness import run
+from enctools.tb.decoder_bench import COMMON_TESTS
+from enctools.harness import run
 
 
 def test_enc_x2_xor():
-    run("enc_x2_xor", "decoder_bench", name="enc_x2_xor", testcase=COMMON_TESTS)
+    run("enc_x2_xor", "enctools.tb.decoder_bench", name="enc_x2_xor", testcase=COMMON_TESTS)

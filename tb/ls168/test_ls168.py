@@ -14,8 +14,10 @@ import cocotb
 import pytest
 from cocotb.triggers import FallingEdge, RisingEdge, Timer
 
-import tbutil
-from harness import run
+from enctools.tb import cocotb_test
+
+from enctools import tb as tbutil
+from enctools.harness import run
 
 
 # ----------------------------------------------------------------------------------------------
@@ -67,7 +69,7 @@ async def drive_and_check(dut, model, load_n, enp_n, ent_n, up, d, what):
     assert int(dut.q.value) == model.q, f"{what}: q={int(dut.q.value)} expected {model.q}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def function_table(dut):
     """Every state x every control combination: load priority, ENP/ENT, U/D, wrap, RCO_n."""
     modulus = int(dut.MODULUS.value)
@@ -83,7 +85,7 @@ async def function_table(dut):
             await drive_and_check(dut, model, load_n, enp_n, ent_n, up, d, what)
 
 
-@cocotb.test()
+@cocotb_test()
 async def illegal_states_recover(dut):
     """A state above MAX rejoins 0..MAX within two counting clocks, in either direction."""
     modulus = int(dut.MODULUS.value)
@@ -97,7 +99,7 @@ async def illegal_states_recover(dut):
             assert int(dut.q.value) < modulus, f"state {state} did not rejoin 0..{modulus - 1}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def random_controls(dut):
     """Long random sequence of controls against the model."""
     model = Ls168Model(int(dut.MODULUS.value))
@@ -135,7 +137,7 @@ async def cascade_step(dut, expect, load_n, en_n, up, d_value, modulus, what):
     return expect
 
 
-@cocotb.test()
+@cocotb_test()
 async def cascade_wraps_both_ways(dut):
     """Three stages count up through MAX..0 and down through 0..MAX, then a random walk."""
     modulus = int(dut.MODULUS.value)
@@ -165,12 +167,12 @@ async def cascade_wraps_both_ways(dut):
 # ----------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("modulus", [10, 16])
 def test_ls168(modulus):
-    run("ls168", "test_ls168", name=f"ls168_m{modulus}", parameters={"MODULUS": modulus},
+    run("ls168", __name__, name=f"ls168_m{modulus}", parameters={"MODULUS": modulus},
         testcase="function_table,illegal_states_recover,random_controls")
 
 
 @pytest.mark.parametrize("modulus", [10, 16])
 def test_ls168_cascade(modulus):
-    run("ls168_cascade3", "test_ls168", name=f"ls168_cascade3_m{modulus}",
+    run("ls168_cascade3", __name__, name=f"ls168_cascade3_m{modulus}",
         parameters={"MODULUS": modulus}, tb_sources=("ls168_cascade3.v",),
         testcase="cascade_wraps_both_ways")

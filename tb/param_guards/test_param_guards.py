@@ -8,8 +8,9 @@ import subprocess
 
 import pytest
 
-from core_file import TOP, files_for, guard_cases
-from harness import sim_name
+from enctools.core import files_for, guard_cases
+from enctools.paths import TOP
+from enctools.harness import sim_name
 
 CASES = list(guard_cases())
 

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from core_file import TOP, files_for, guard_cases  # noqa: E402
+from enctools.core import files_for, guard_cases
+from enctools.paths import TOP
 
 # module -> [(parameter, bad value, name the message must contain)]: every out-of-range value of
 # every ranged parameter in enc_ip.core, plus the board's relational limits the core cannot express

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from core_file import TOP, board_files, files_for, rtl_files
+from enctools.core import board_files, files_for, rtl_files
+from enctools.paths import TOP
 
 FILES = rtl_files() + board_files()
 

@@ -4,7 +4,7 @@
 DUT: tb/hdl/enc_quad_probe.v (enc_conditioner -> enc_x4_decoder, enc_x2_xor, enc_x1_hysteresis
 with net-count accumulators and flag counters), built with FILTER_LEN = 3 (the default) and 1
 (no filter: the note's programmed-input sampling, one sample per clock). Shared logic, the
-definition of "exact" and of "silent loss", and the two predictions are in tb/common/sweeps.py; the
+definition of "exact" and of "silent loss", and the two predictions are in enctools.benches.sweeps; the
 dense version of these sweeps is scripts/sweep.py (`make sweep`).
 
 Every point is one constant-speed run of one modelled unit; the truth is the model's waveform
@@ -34,12 +34,14 @@ from __future__ import annotations
 import math
 
 import cocotb
+
+from enctools.tb import cocotb_test
 import numpy as np
 import pytest
 
-from harness import run
+from enctools.harness import run
 from hedsmodel import EncoderUnit, measure, note
-from sweeps import (CLK_NS, MARGIN, assert_exact, assert_no_silent_loss, boundary_search,
+from enctools.benches.sweeps import (CLK_NS, MARGIN, assert_exact, assert_no_silent_loss, boundary_search,
                     filter_len, limits, run_point, start, unit_dict, waveform)
 
 TOLERANCE = 0.05     # measured boundary within 5 % of the prediction
@@ -83,7 +85,7 @@ async def check_points(dut, rng, points, inside_max=1.0, outside_min=math.inf):
     return results
 
 
-@cocotb.test()
+@cocotb_test()
 async def frequency_sweep(dut):
     """A typical unit from a 120 rpm crawl to 3 x the count limit: exact inside, flagged past.
 
@@ -110,7 +112,7 @@ async def frequency_sweep(dut):
     await check_points(dut, rng, points, inside_max=1.0, outside_min=1.5)
 
 
-@cocotb.test()
+@cocotb_test()
 async def count_limit_boundary(dut):
     """Highest exact frequency vs the prediction, for a level-bound and a state-bound unit."""
     rng = await start(dut)
@@ -130,7 +132,7 @@ async def count_limit_boundary(dut):
             f"from the predicted {b['f_limit_hz']:.0f} Hz (allowed 0 .. +5 %)")
 
 
-@cocotb.test()
+@cocotb_test()
 async def phase_error_sweep(dut):
     """Phase error 0 .. ±60 e°: exact at 0.95 x each unit's limit, flagged at 1.3 x."""
     rng = await start(dut)
@@ -150,7 +152,7 @@ async def phase_error_sweep(dut):
     await check_points(dut, rng, points, inside_max=1.0, outside_min=1.3)
 
 
-@cocotb.test()
+@cocotb_test()
 async def state_width_error_sweep(dut):
     """At 200 kHz, state-width error up to the limit the count rule allows there, and past it."""
     rng = await start(dut)
@@ -172,7 +174,7 @@ async def state_width_error_sweep(dut):
             must_flag(res)
 
 
-@cocotb.test()
+@cocotb_test()
 async def temperature_sweep(dut):
     """Worst-case α: the pulse width moves by α ΔT f, the counts stay exact inside the limit."""
     rng = await start(dut)
@@ -199,7 +201,7 @@ async def temperature_sweep(dut):
             must_flag(res)
 
 
-@cocotb.test()
+@cocotb_test()
 async def sampling_rule(dut):
     """FILTER_LEN = 1, one sample per clock: T_p <= T_s (1 - ΔS_max/90) is exactly the boundary."""
     rng = await start(dut)
@@ -232,6 +234,6 @@ SETS = {
 
 @pytest.mark.parametrize("filter_len", sorted(SETS, reverse=True))
 def test_sweeps(filter_len):
-    run("enc_quad_probe", "test_sweeps", name=f"sweeps_F{filter_len}",
+    run("enc_quad_probe", __name__, name=f"sweeps_F{filter_len}",
         parameters={"FILTER_LEN": filter_len}, tb_sources=("enc_quad_probe.v",),
         testcase=SETS[filter_len])

@@ -8,7 +8,6 @@ layer's figure."""
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -25,10 +24,8 @@ SCRIPT = TOP / "scripts" / "velocity_bench.py"
 
 @pytest.fixture(scope="module")
 def bench():
-    spec = importlib.util.spec_from_file_location("velocity_bench", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    from enctools import velocity_bench
+    return velocity_bench
 
 
 @pytest.mark.parametrize("argv,fragment", [

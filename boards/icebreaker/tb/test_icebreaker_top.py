@@ -37,12 +37,13 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
-from core_file import TOP, board_files
-from harness import run
+from enctools.core import board_files
+from enctools.paths import TOP
+from enctools.harness import run
 from cocotbext.quadrature import play
 from hedsmodel.waveform import QUAD, STATE_TO_POS, Waveform
-from qei_tb import addr, event_bits, extra_sources, get_field, pack
-from tbutil import log_seed
+from enctools.qei.bus import addr, event_bits, get_field, pack
+from enctools.tb import cocotb_test, log_seed
 
 CLK_HZ = 12_000_000
 CLK_PS = 83_334  # 12 MHz (even, for cocotb's 50 % Clock)
@@ -237,7 +238,7 @@ async def index_pulse(dut, at_ns: float, width_ns: float) -> None:
 # ------------------------------------------------------------------------------------------------
 # the test
 # ------------------------------------------------------------------------------------------------
-@cocotb.test()
+@cocotb_test()
 async def board_session(dut):
     """Random walk with quiet spells, glitch, index, steady rotation at 90/100 degrees both ways,
     an illegal transition; every report line decoded and checked."""
@@ -364,6 +365,6 @@ async def board_session(dut):
 @pytest.mark.parametrize("pos_width", [24, 8])
 def test_icebreaker_top(pos_width):
     # enc_qei's files come from the core's rtl fileset; extra_sources() adds any it lacks
-    run("icebreaker_top", "test_icebreaker_top", name=f"icebreaker_top_w{pos_width}",
+    run("icebreaker_top", __name__, name=f"icebreaker_top_w{pos_width}",
         parameters={**PARAMS, "POS_WIDTH": pos_width}, extra_env={"IB_POS_WIDTH": str(pos_width)},
-        extra_sources=extra_sources() + tuple(TOP / f for f in board_files("icebreaker")))
+        extra_sources=tuple(TOP / f for f in board_files("icebreaker")))

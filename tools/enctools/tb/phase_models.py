@@ -24,9 +24,16 @@ import math
 import random
 from dataclasses import dataclass
 
+import cocotb
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.utils import get_sim_time
+from cocotbext.quadrature import play
 from hedsmodel.waveform import STATE_TO_POS, Waveform
 
+from enctools import tb as tbutil
+
 CLK_PS = 10_000  # test clock period (10 ns); rising edges at multiples of it from time 0
+LSB = 1.0 / 256.0  # degrees per phase_err LSB
 
 
 @dataclass
@@ -264,3 +271,55 @@ def sampled_meter_reading(wf: Waveform, window_log2: int, clk_ps: int = CLK_PS):
             x += hi - lo
     t = last - s0
     return (46080 * x) // t - 23040, x, t
+
+
+# ---- driving the meter ----------------------------------------------------------------------
+def window_log2(dut) -> int:
+    return int(dut.WINDOW_LOG2.value)
+
+
+async def start_clock(dut):
+    await tbutil.start(dut, CLK_PS, {"a": 0, "b": 0}, do_reset=False)
+
+
+async def reset(dut, clocks: int = 2):
+    dut.rst.value = 1
+    for _ in range(clocks):
+        await FallingEdge(dut.clk)
+    dut.rst.value = 0
+
+
+class Readings:
+    """Collects (time_ps, phase_err degrees - as read -, a_leads, b_leads) on every valid pulse."""
+
+    def __init__(self, dut):
+        self.dut = dut
+        self.items = []
+        self.task = cocotb.start_soon(self._run())
+
+    async def _run(self):
+        while True:
+            await RisingEdge(self.dut.valid)
+            await ReadOnly()
+            self.items.append((get_sim_time("ps"), self.dut.phase_err.value.to_signed() * LSB,
+                               int(self.dut.a_leads.value), int(self.dut.b_leads.value)))
+            await RisingEdge(self.dut.clk)
+            await ReadOnly()
+            assert int(self.dut.valid.value) == 0, "valid is longer than one clock"
+
+    def stop(self):
+        self.task.cancel()
+
+
+async def play_case(dut, wf):
+    """Reset with the waveform's first levels on a/b (so the jump from the previous case's levels
+    is not an edge), then play ``wf`` from a falling clock edge; returns (readings, start_ps)."""
+    _, a0, b0 = wf.events[0]
+    dut.a.value, dut.b.value = a0, b0
+    await reset(dut)
+    start_ps = get_sim_time("ps")
+    rd = Readings(dut)
+    await play(dut, off_grid(wf, start_ps), "a", "b")
+    await FallingEdge(dut.clk)
+    rd.stop()
+    return rd.items, start_ps

@@ -12,8 +12,10 @@ import random
 import cocotb
 from cocotb.triggers import FallingEdge
 
-import tbutil
-from models import X1Model, X2Model, X4Model
+from enctools.tb import cocotb_test
+
+from enctools import tb as tbutil
+from enctools.tb.models import X1Model, X2Model, X4Model
 from hedsmodel.waveform import state_of
 
 MODELS = {"enc_x4_decoder": X4Model, "enc_x2_xor": X2Model, "enc_x1_hysteresis": X1Model}
@@ -110,7 +112,7 @@ def model_for(dut):
     return MODELS[dut._name]()
 
 
-@cocotb.test()
+@cocotb_test()
 async def random_walk_20k(dut):
     """20,000 transitions, 1-3 clocks per state, reversals, ~1% illegal jumps: exact per clock."""
     await start(dut)
@@ -118,7 +120,7 @@ async def random_walk_20k(dut):
     await play_samples(dut, random_walk(rng, 20000, p_illegal=0.01), model_for(dut))
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_mid_motion(dut):
     """Random walk with rst asserted at random clocks while the shaft moves."""
     await start(dut)
@@ -127,7 +129,7 @@ async def reset_mid_motion(dut):
                        model_for(dut))
 
 
-@cocotb.test()
+@cocotb_test()
 async def reversal_at_every_state(dut):
     """From each reset state, run k = 0..7 steps in each direction, then reverse for 9."""
     await start(dut)
@@ -145,7 +147,7 @@ async def reversal_at_every_state(dut):
                 await play_samples(dut, s, model, bound=4 if "x1" in dut._name else None)
 
 
-@cocotb.test()
+@cocotb_test()
 async def dither_every_transition(dut):
     """Approach each of the four transitions from both sides, then dither across it 40 times."""
     await start(dut)
@@ -168,7 +170,7 @@ async def dither_every_transition(dut):
                 await play_samples(dut, s, model, bound=4 if "x1" in dut._name else None)
 
 
-@cocotb.test()
+@cocotb_test()
 async def monotone_runs(dut):
     """From reset at every state, 4m transitions in one direction give exactly 4m (x4), 2m (x2) or
     m (x1) counts in that direction and none in the other."""
@@ -191,7 +193,7 @@ async def monotone_runs(dut):
                                           f"{got[0]} counts forward-in-direction, {got[1]} against; want {want}, 0")
 
 
-@cocotb.test()
+@cocotb_test()
 async def x1_hysteresis_bound(dut):
     """The contract's latched-hysteresis property, checked on the outputs alone (no model): dither
     about every transition and random walks never let |4n - p| exceed 4 (the contract's bound)."""
@@ -212,7 +214,7 @@ async def x1_hysteresis_bound(dut):
     await play_samples(dut, random_walk(rng, 3000), bound=4)
 
 
-@cocotb.test()
+@cocotb_test()
 async def reset_then_illegal_jump(dut):
     """A one-clock reset followed at once, on the first clock after it, by a jump of either channel
     or of both (the illegal two-channel change): that first sample is only the new reference, so

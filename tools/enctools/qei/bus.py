@@ -1,116 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Shared pieces of the enc_qei tests: the register map read from the compiled RDL, one bus
-object over the ecosystem's masters (cocotbext-wishbone WishboneMaster or cocotbext-axi
-AxiLiteMaster with random back-pressure on every channel), the test start, and the pytest-side
-source list."""
+"""The bus of the enc_qei tests: one object over the ecosystem's masters (cocotbext-wishbone
+WishboneMaster or cocotbext-axi AxiLiteMaster with random back-pressure on every channel), with
+register access by name (the register map is enctools.regmap), and clock-exact stimulus."""
 
 from __future__ import annotations
 
 import logging
 import random
-import sys
-from dataclasses import dataclass
-from functools import lru_cache
-from pathlib import Path
 
-TOP = Path(__file__).resolve().parents[2]
-RDL = TOP / "rtl" / "enc_qei.rdl"
-QEI_RTL = ("enc_conditioner_rt.v", "enc_qei_core.v", "enc_qei_timing.v", "enc_qei_regs.v",
-           "enc_qei.v", "enc_qei_wb.v", "enc_qei_axil.v")
+from enctools.regmap import (addr, enum, event_bits, event_names, field_val, get_field, pack,  # noqa: F401
+                             regmap, size_mask)
+
 PERIOD_PS = 10_000  # 100 MHz
 T_NS = PERIOD_PS / 1000
-
-
-def extra_sources() -> tuple[Path, ...]:
-    """The enc_qei RTL files the harness does not already take from enc_ip.core."""
-    from harness import rtl_sources
-
-    have = {p.name for p in rtl_sources()}
-    return tuple(TOP / "rtl" / f for f in QEI_RTL if f not in have)
-
-
-# ---- register map from the RDL ----------------------------------------------------------------------
-@dataclass
-class Field:
-    name: str
-    lsb: int
-    width: int
-    sw: str
-    hw: str
-    reset: int | None
-    sized_by: str | None
-    enum: dict | None
-    kind: str
-
-    @property
-    def mask(self) -> int:
-        return ((1 << self.width) - 1) << self.lsb
-
-
-@dataclass
-class Reg:
-    name: str
-    offset: int
-    external: bool
-    fields: dict
-
-
-@lru_cache(maxsize=None)
-def regmap() -> dict:
-    sys.path.insert(0, str(TOP / "scripts"))
-    from gen_regs import compile_rdl, field_kind
-
-    regs = {}
-    for r in compile_rdl(RDL).registers():
-        fields = {}
-        for f in r.fields():
-            enc = f.get_property("encode")
-            fields[f.inst_name] = Field(
-                f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
-                f.get_property("reset"), f.get_property("sized_by"),
-                {m.name: m.value for m in enc} if enc is not None else None, field_kind(f))
-        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.external, fields)
-    return regs
-
-
-def addr(reg: str) -> int:
-    return regmap()[reg].offset
-
-
-def field_val(reg: str, field: str, value) -> int:
-    """The register bits of ``field`` = value (an int or an enum member name)."""
-    f = regmap()[reg].fields[field]
-    if isinstance(value, str):
-        value = f.enum[value]
-    assert 0 <= value < (1 << f.width), (reg, field, value)
-    return value << f.lsb
-
-
-def get_field(reg: str, field: str, word: int) -> int:
-    f = regmap()[reg].fields[field]
-    return (word >> f.lsb) & ((1 << f.width) - 1)
-
-
-def pack(reg: str, **fields) -> int:
-    return sum(field_val(reg, k, v) for k, v in fields.items())
-
-
-def event_names(word: int) -> set[str]:
-    return {n for n, f in regmap()["EVENTS"].fields.items() if word & f.mask}
-
-
-def event_bits(*names: str) -> int:
-    return sum(regmap()["EVENTS"].fields[n].mask for n in names)
-
-
-def size_mask(sized_by: str | None, count_w: int, ts_w: int) -> int:
-    if sized_by == "COUNT_W:0":
-        return (1 << min(32, count_w)) - 1
-    if sized_by == "COUNT_W:1":
-        return (1 << max(0, count_w - 32)) - 1
-    if sized_by == "TS_W":
-        return (1 << ts_w) - 1
-    return 0xFFFFFFFF
 
 
 # ---- bus ------------------------------------------------------------------------------------------
@@ -201,10 +103,10 @@ async def play_clocks(env, model, clocks) -> None:
     the falling edge before that clock's rising edge, so that with FILTER_LEN 1 (a level of one
     clock is kept) each change is sampled in exactly that clock: steps in consecutive clocks, an
     index edge in the clock of a step or right before one. Every change of (A, B) or Z is one
-    sample of the model (qei_model.QeiModel.sample), in order. ``env`` is test_enc_qei.Env (its
+    sample of the model (qei_model.QeiModel.sample), in order. ``env`` is the test environment (its
     ``pos`` is kept; ``z`` is the Z level now)."""
     from cocotb.triggers import FallingEdge
-    from qei_model import QUAD
+    from enctools.qei.model import QUAD
 
     dut = env.dut
     prev = (env.pos % 4, getattr(env, "z", 0))

@@ -7,7 +7,7 @@ test_count_rate.py), with QERR never set (GLITCH may fire there: a reversal afte
 level of one channel shorter than the filter, rejected without a loss); below the bound every walk is exact or
 has QERR/GLITCH set: never a silent loss. COUNT is read as COUNT_LO then COUNT_HI over
 Wishbone (enc_qei_wb) or AXI4-Lite with random back-pressure (enc_qei_axil), through the bus
-models of tb/enc_qei/qei_tb.py. The `sweep` test is the benchmark driver of scripts/count_rate.py.
+models of enctools.qei. The `sweep` test is the benchmark driver of scripts/count_rate.py.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from cocotb.triggers import ClockCycles
 
 from cocotbext.quadrature import QuadratureDriver
 from hedsmodel.waveform import random_walk
-from qei_tb import PERIOD_PS, T_NS, QeiBus, pack
-from tbutil import reset_dut, start
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, pack
+from enctools.tb import cocotb_test, reset_dut, start
 
 
 class Qei:
@@ -73,7 +73,7 @@ def bound_clocks(f: int) -> float:
     return max(1.0, f / 2)
 
 
-@cocotb.test()
+@cocotb_test()
 async def exact_at_bound(dut):
     """F = 1..4 at run time: 8,000 transitions each at S = 1.05 x max(1, F/2), exact, no QERR."""
     qei, rng = await begin(dut)
@@ -84,7 +84,7 @@ async def exact_at_bound(dut):
         assert not r["qerr"], f"QERR at the contract's bound: {r}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def never_silent(dut):
     """Past the bound (F = 3: levels shorter than the filter; states under one clock): every walk
     exact or flagged, and states under one clock always flagged."""
@@ -97,7 +97,7 @@ async def never_silent(dut):
             assert r["flagged"], f"states under one clock but neither QERR nor GLITCH: {r}"
 
 
-@cocotb.test()
+@cocotb_test()
 async def sweep(dut):
     """Benchmark driver (scripts/count_rate.py --dut qei): points from ENC_POINTS."""
     qei, _ = await begin(dut)

@@ -17,7 +17,7 @@ the clock, waits FILTER_LEN + 6 clocks and reads the accumulators. The truth com
 waveform itself (``Waveform.positions``: the states the unit's outputs actually show), the timing
 from :func:`hedsmodel.measure` and from the event list:
 
-- ``exact``: pos4 == true 4X change, pos2 == true 2X change ((p + 1) // 2, tb/common/models.py),
+- ``exact``: pos4 == true 4X change, pos2 == true 2X change ((p + 1) // 2, enctools.tb.models),
   |4 pos1 - p| < 8 (the contract's 1X hysteresis bound), and no error / glitch flag at all;
 - ``silent4`` / ``silent2`` / ``silent1``: a count is wrong (pos1: out of its bound) and its path
   raised no flag (n_err4 / n_err2 / n_err1 + n_glitch = 0): the one outcome the contract never
@@ -40,10 +40,10 @@ import cocotb
 from cocotb.triggers import FallingEdge, Timer
 
 from hedsmodel import EncoderUnit, Profile, budget, measure
-import tbutil
-from models import two_x_count
+from enctools import tb as tbutil
+from enctools.tb.models import two_x_count
 from cocotbext.quadrature import play
-from tbutil import reset_dut
+from enctools.tb import cocotb_test, reset_dut
 
 CLK_PS = 83333                  # 12 MHz clock period, ps (odd: start_clock handles it)
 CLK_NS = CLK_PS / 1000.0
@@ -284,7 +284,7 @@ async def boundary_search(dut, base: dict, rng: random.Random, lo: float = 0.98,
             "first_bad_hz": bad, "ratio": ok / f_lim, "results": results}
 
 
-@cocotb.test()
+@cocotb_test()
 async def sweep_points(dut):
     """scripts/sweep.py: run the job in $ENC_SWEEP_POINTS (a JSON file: {"points": [point, ...],
     "boundary": [point, ...]}; a boundary entry is a unit to walk up to its count limit) and

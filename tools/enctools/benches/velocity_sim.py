@@ -28,7 +28,7 @@ from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import QuadratureDriver, start_clock
 from hedsmodel.waveform import Waveform
-from tbutil import reset_dut
+from enctools.tb import cocotb_test, reset_dut
 
 READ_REGS = ("SNAP_COUNT_LO", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA",
              "PERIOD", "PERIOD_CTRL", "STATUS")
@@ -68,7 +68,7 @@ async def _until(t_ps: float) -> None:
         await Timer(int(round(t_ps - now)), unit="ps")
 
 
-@cocotb.test()
+@cocotb_test()
 async def velocity_reads(dut):
     plan = json.loads(open(os.environ["ENC_VEL_PLAN"]).read())
     clk_ps = int(plan["clk_ps"])

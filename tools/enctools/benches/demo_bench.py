@@ -3,7 +3,7 @@
 tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/demo.py compares
 the records with the model and prints the table.
 
-The bus peripheral enc_qei_wb is read as a host would, over Wishbone through tb/enc_qei/qei_tb.py's
+The bus peripheral enc_qei_wb is read as a host would, over Wishbone through enctools.qei.bus's
 QeiBus (cocotbext-wishbone's WishboneMaster; register offsets and fields from the compiled
 rtl/enc_qei.rdl): once the waveform starts, STALL_TIMEOUT and SNAP_CTRL.EDGE are written; at each
 planned read time a snapshot is commanded (SNAP_CTRL.CMD) and SNAP_COUNT_LO, SNAP_TIME,
@@ -29,8 +29,10 @@ from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import play
+
+from enctools.tb import cocotb_test
 from hedsmodel.waveform import Waveform
-from qei_tb import QeiBus, get_field, pack  # tb/enc_qei/ (on the runner's path via harness)
+from enctools.qei.bus import QeiBus, get_field, pack  # tb/enc_qei/ (on the runner's path via harness)
 
 QEI_READS = ("SNAP_COUNT_LO", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA",
              "STATUS")
@@ -146,7 +148,7 @@ async def _qei_reads(bus: QeiBus, t0_ps: float, qei: dict, out: list) -> None:
         out.append({"t_ack_ps": t_ack, **words})
 
 
-@cocotb.test()
+@cocotb_test()
 async def demo(dut):
     plan = json.loads(open(os.environ["ENC_DEMO_PLAN"]).read())
     clk_ps = int(plan["clk_ps"])

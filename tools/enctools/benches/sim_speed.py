@@ -13,12 +13,12 @@ from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import play, start_clock
 from hedsmodel.waveform import random_walk
-from tbutil import reset_dut
+from enctools.tb import cocotb_test, reset_dut
 
 PERIOD_PS = 83_333  # 12 MHz
 
 
-@cocotb.test()
+@cocotb_test()
 async def speed(dut):
     cfg = json.loads(os.environ["ENC_SPEED"])
     await start_clock(dut.clk, PERIOD_PS)

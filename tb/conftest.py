@@ -1,8 +1,0 @@
-# SPDX-License-Identifier: Apache-2.0
-"""pytest: the shared helpers in tb/common/ (harness, models, tbutil) are importable by name from
-every test folder."""
-
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parent / "common"))

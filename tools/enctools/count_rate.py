@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Count-rate benchmark: the shortest state width (in clock periods) at which the conditioner +
+decoders still count exactly, for FILTER_LEN = 1..4, against the contract's bound max(1, F/2).
+
+For each F it plays random walks of N transitions (states uniform [S, 2S] clocks, edges off the
+clock grid, 30% reversals) for several seeds, at S = bound x ratio for ratios going down from
+1.10, and reports the smallest S at which every seed at that S and above was exact. Exact means
+the 4X and 2X counts equal the true position and the 1X count stays in its hysteresis band.
+With --dut qei the same walks go through the peripheral: enc_qei_wb, FUNC x4, CTRL.FILTER_LEN set
+at run time, COUNT read over Wishbone; exact means COUNT equals the true 4X position, and a miss
+must have set QERR or GLITCH. Runs on Verilator by default (SIM=icarus also works, slower). Prints a progress line per point
+and a markdown table (also written to doc/results/count_rate.md).
+
+    scripts/count_rate.py [--transitions 20000] [--seeds 3] [--filters 1 2 3 4] [--sim verilator]
+                          [--seed 1000] [--jobs 2] [--dut probe|qei|both]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from .paths import TOP
+
+RATIOS = (1.10, 1.07, 1.05, 1.03, 1.02, 1.01, 1.00, 0.99, 0.98, 0.97, 0.95, 0.92, 0.90)
+
+
+def positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number")
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text} must be at least 1")
+    return v
+
+
+def filter_len(text: str) -> int:
+    v = positive_int(text)
+    if v > 16:
+        raise argparse.ArgumentTypeError(f"FILTER_LEN {v} is outside 1 .. 16")
+    return v
+
+
+DUTS = {  # --dut: (what the table calls it, how to run a list of points)
+    "probe": "conditioner + decoders (tb/hdl/enc_quad_probe.v)",
+    "qei": "enc_qei_wb (FUNC x4, COUNT over Wishbone)",
+}
+
+
+def run_points(dut: str, f: int, points: list[dict]) -> list[dict]:
+    from .harness import run
+
+    env = {"ENC_POINTS": json.dumps([dict(pt, f=f) for pt in points])}
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "results.json"
+        env["ENC_RESULTS"] = str(out)
+        if dut == "probe":
+            run("enc_quad_probe", "enctools.benches.count_rate_probe", name=f"count_rate_bench_f{f}",
+                parameters={"FILTER_LEN": f}, tb_sources=("enc_quad_probe.v",), testcase="sweep",
+                extra_env=env, quiet=True)
+        else:
+            run("enc_qei_wb", "enctools.benches.count_rate_qei", name=f"count_rate_bench_qei_f{f}", testcase="sweep",
+                extra_env=env, quiet=True)
+        return json.loads(out.read_text())
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--transitions", type=positive_int, default=20000,
+                    help="transitions per walk (default 20000)")
+    ap.add_argument("--seeds", type=positive_int, default=3, help="walks per point (default 3)")
+    ap.add_argument("--filters", type=filter_len, nargs="+", default=[1, 2, 3, 4],
+                    help="FILTER_LEN values (default 1 2 3 4)")
+    ap.add_argument("--sim", choices=("icarus", "verilator"), default="verilator",
+                    help="simulator (default verilator)")
+    ap.add_argument("--seed", type=int, default=1000,
+                    help="base seed: walk k of FILTER_LEN F uses seed*F + k (default 1000)")
+    ap.add_argument("--jobs", type=positive_int, default=2, help="FILTER_LEN values run in parallel")
+    ap.add_argument("--dut", choices=("probe", "qei", "both"), default="both",
+                    help="the bare circuits, the enc_qei peripheral, or both (default)")
+    args = ap.parse_args()
+    os.environ["SIM"] = args.sim
+
+    t0 = time.time()
+    duts = ["probe", "qei"] if args.dut == "both" else [args.dut]
+
+    def one_filter(job):
+        dut, f = job
+        bound = max(1.0, f / 2)
+        smallest_exact = None
+        failed_at = None
+        for ratio in RATIOS:
+            s = round(bound * ratio, 4)
+            points = [{"s": s, "n": args.transitions, "seed": args.seed * f + k} for k in range(args.seeds)]
+            results = run_points(dut, f, points)
+            exact = all(r["exact"] for r in results)
+            silent = [r for r in results if not r["exact"] and not r["flagged"]]
+            print(f"count_rate: {dut} F={f} S={s:.3f} clocks ({ratio:.2f} x bound): "
+                  f"{'exact' if exact else 'NOT exact'} over {args.seeds} x {args.transitions} transitions"
+                  f"{', SILENT MISCOUNT' if silent else ''}  [{time.time() - t0:.0f} s]", flush=True)
+            if silent:
+                raise SystemExit(f"count_rate: silent miscount: {silent[0]}")
+            if not exact:
+                failed_at = s
+                break
+            smallest_exact = s
+        return dut, f, bound, smallest_exact, failed_at
+
+    with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        rows = list(pool.map(one_filter, [(d, f) for d in duts for f in args.filters]))
+
+    lines = ["| circuit | FILTER_LEN | bound max(1, F/2) (clocks) | smallest exact S (clocks) | ratio to bound | first failing S |",
+             "|---|---:|---:|---:|---:|---:|"]
+    ok = True
+    for dut, f, bound, s, failed in rows:
+        ratio = s / bound if s else float("nan")
+        ok &= s is not None and abs(ratio - 1) <= 0.05
+        lines.append(f"| {DUTS[dut]} | {f} | {bound:.2f} | {s if s else '-'} | {ratio:.2f} | "
+                     f"{failed if failed else 'none down to ' + str(round(bound * RATIOS[-1], 3))} |")
+    table = "\n".join(lines)
+    note = (f"\n{args.seeds} seeds x {args.transitions:,} transitions per point, states uniform "
+            f"[S, 2S] clock periods, edges off the clock grid, simulator {os.environ['SIM']}. "
+            "No point below the bound miscounted silently (the run stops if one does).\n")
+    print(table + note)
+    (TOP / "doc" / "results" / "count_rate.md").write_text(table + "\n" + note)
+    print("count_rate: every F within 5% of its bound" if ok else "count_rate: some F NOT within 5% of its bound")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
