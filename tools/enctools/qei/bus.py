@@ -15,12 +15,23 @@ PERIOD_PS = 10_000  # 100 MHz
 T_NS = PERIOD_PS / 1000
 
 
+def signed(value: int, bits: int = 32) -> int:
+    """A ``bits``-wide register value read as two's complement (SNAP_DELTA, a count)."""
+    value &= (1 << bits) - 1
+    return value - (1 << bits) if value >> (bits - 1) else value
+
+
 # ---- bus ------------------------------------------------------------------------------------------
 class QeiBus:
-    """read(offset) -> (data, err); write(offset, data, strb) -> err, on either adapter."""
+    """read(offset) -> (data, err); write(offset, data, strb) -> err, on either adapter; by
+    register name with rd / wr / read_many. ``offsets`` (name -> byte offset) replaces the
+    register map's offsets (a bench simulating the RTL of another revision); ``rng`` drives the
+    AXI4-Lite back-pressure (default: a fixed seed)."""
 
-    def __init__(self, dut, rng: random.Random):
+    def __init__(self, dut, rng: random.Random | None = None, offsets: dict | None = None):
         self.dut = dut
+        self.offsets = offsets
+        rng = rng or random.Random(1)
         self.kind = "axil" if hasattr(dut, "s_axil_awaddr") else "wb"
         if self.kind == "wb":
             from cocotbext.wishbone.driver import WishboneMaster
@@ -68,14 +79,29 @@ class QeiBus:
         return int(resp.resp) != 0
 
     # convenience, by register name
+    def offset(self, reg: str) -> int:
+        return self.offsets[reg] if self.offsets is not None else addr(reg)
+
     async def rd(self, reg: str) -> int:
-        value, err = await self.read(addr(reg))
+        value, err = await self.read(self.offset(reg))
         assert not err, f"read of {reg} answered an error"
         return value
 
     async def wr(self, reg: str, value: int, strb: int = 0xF) -> None:
-        err = await self.write(addr(reg), value, strb)
+        err = await self.write(self.offset(reg), value, strb)
         assert not err, f"write of {reg} answered an error"
+
+    async def read_many(self, regs) -> list[int]:
+        """Several registers in one bus transaction where the bus has one (a Wishbone block
+        cycle), one after the other otherwise."""
+        if self.kind != "wb":
+            return [await self.rd(r) for r in regs]
+        from cocotbext.wishbone.driver import WBOp
+
+        res = await self.m.send_cycle([WBOp(adr=self.offset(r), dat=None, sel=0xF) for r in regs])
+        for r, x in zip(regs, res):
+            assert x.ack != 2, f"read of {r} answered an error"
+        return [int(x.datrd) for x in res]
 
     async def count(self) -> int:
         lo = await self.rd("COUNT_LO")
