@@ -48,6 +48,7 @@ RDL = TOP / "rtl" / "enc_qei.rdl"
 OUT_H = TOP / "sw" / "enc_qei_regs.h"
 OUT_MD = TOP / "doc" / "enc_qei_regs.md"
 OUT_V = TOP / "rtl" / "enc_qei_regs.v"
+OUT_VH = TOP / "rtl" / "enc_qei_regs.vh"
 
 SIZE_MASKS = {"COUNT_W:0": "SZ_COUNT_LO", "COUNT_W:1": "SZ_COUNT_HI", "TS_W": "SZ_TS"}
 
@@ -373,6 +374,10 @@ def generate(out_dir: Path | None = None) -> dict[Path, Path]:
     vpath = (out_dir / OUT_V.name) if out_dir else OUT_V
     vpath.write_text(verilog(top))
     written[OUT_V] = vpath
+    from . import regs_vh
+    vh = (out_dir / OUT_VH.name) if out_dir else OUT_VH
+    vh.write_text(regs_vh.render(top))
+    written[OUT_VH] = vh
     return written
 
 
