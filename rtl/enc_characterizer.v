@@ -37,6 +37,7 @@
 //
 // Inputs a and b must be synchronous to clk (from enc_conditioner).
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_characterizer #(
     parameter integer CNT_W = 16,  // state width counter bits: states up to 2^CNT_W - 2 clocks; 8 .. 24
@@ -57,20 +58,8 @@ module enc_characterizer #(
 );
 
   generate
-    if (CNT_W < 8 || CNT_W > 24) begin : g_bad_cnt_w
-`ifdef __ICARUS__
-      enc_characterizer__parameter_CNT_W_must_be_8_to_24 u_stop ();
-`else
-      $error("enc_characterizer: parameter CNT_W must be in 8 .. 24");
-`endif
-    end
-    if (WINDOW_CYCLES < 1 || WINDOW_CYCLES > 16384) begin : g_bad_window_cycles
-`ifdef __ICARUS__
-      enc_characterizer__parameter_WINDOW_CYCLES_must_be_1_to_16384 u_stop ();
-`else
-      $error("enc_characterizer: parameter WINDOW_CYCLES must be in 1 .. 16384");
-`endif
-    end
+    `ENC_CHECK_CNT_W
+    `ENC_CHECK_WINDOW_CYCLES
   endgenerate
 
   localparam integer NC_W = $clog2(WINDOW_CYCLES + 1);  // cycle counter bits

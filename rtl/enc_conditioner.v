@@ -16,6 +16,7 @@
 // clock. A decoder behind the conditioner should be held in reset until then (rst | ~valid), or
 // it would take 00 as its reference state and count the jump to the real state.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_conditioner #(
     parameter integer FILTER_LEN = 3  // samples a new level must persist: 1 .. 16 (1 = no filter)
@@ -31,13 +32,7 @@ module enc_conditioner #(
 );
 
   generate
-    if (FILTER_LEN < 1 || FILTER_LEN > 16) begin : g_bad_filter_len
-`ifdef __ICARUS__
-      enc_conditioner__parameter_FILTER_LEN_must_be_1_to_16 u_stop ();
-`else
-      $error("enc_conditioner: parameter FILTER_LEN must be in 1 .. 16");
-`endif
-    end
+    `ENC_CHECK_FILTER_LEN
   endgenerate
 
   // Run-length counter: number of consecutive samples (so far) that differ from the accepted level;

@@ -16,6 +16,7 @@
 // with filter_len tied to FILTER_LEN and MAX_FILTER_LEN = FILTER_LEN (then the run counter and
 // the settling chain are exactly as wide as the fixed-length circuit's).
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_conditioner_rt #(
     parameter integer MAX_FILTER_LEN = 16  // largest filter_len used: 1 .. 16 (sizes the counters)
@@ -32,13 +33,7 @@ module enc_conditioner_rt #(
 );
 
   generate
-    if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len
-`ifdef __ICARUS__
-      enc_conditioner_rt__parameter_MAX_FILTER_LEN_must_be_1_to_16 u_stop ();
-`else
-      $error("enc_conditioner_rt: parameter MAX_FILTER_LEN must be in 1 .. 16");
-`endif
-    end
+    `ENC_CHECK_MAX_FILTER_LEN
   endgenerate
 
   // Run-length counter: consecutive samples (so far) that differ from the accepted level.

@@ -58,6 +58,7 @@
 //
 // Inputs a and b must be synchronous to clk (from enc_conditioner, which also filters glitches).
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_phase_meter #(
     parameter integer WINDOW_LOG2 = 16  // averaging window of 2^WINDOW_LOG2 clocks; 8 .. 24
@@ -73,13 +74,7 @@ module enc_phase_meter #(
 );
 
   generate
-    if (WINDOW_LOG2 < 8 || WINDOW_LOG2 > 24) begin : g_bad_window_log2
-`ifdef __ICARUS__
-      enc_phase_meter__parameter_WINDOW_LOG2_must_be_8_to_24 u_stop ();
-`else
-      $error("enc_phase_meter: parameter WINDOW_LOG2 must be in 8 .. 24");
-`endif
-    end
+    `ENC_CHECK_WINDOW_LOG2
   endgenerate
 
   localparam integer W = WINDOW_LOG2;

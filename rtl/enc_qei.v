@@ -24,6 +24,7 @@
 //                   reads it and ignores writes, and the decode logic of the others is left out.
 //                   With several, a CTRL.FUNC value outside the mask counts nothing.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei #(
     parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
@@ -51,34 +52,10 @@ module enc_qei #(
 );
 
   generate
-    if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w
-`ifdef __ICARUS__
-      enc_qei__parameter_COUNT_W_must_be_8_to_64 u_stop ();
-`else
-      $error("enc_qei: parameter COUNT_W must be in 8 .. 64");
-`endif
-    end
-    if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w
-`ifdef __ICARUS__
-      enc_qei__parameter_TS_W_must_be_16_to_32 u_stop ();
-`else
-      $error("enc_qei: parameter TS_W must be in 16 .. 32");
-`endif
-    end
-    if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile
-`ifdef __ICARUS__
-      enc_qei__parameter_PROFILE_must_be_1_to_2 u_stop ();
-`else
-      $error("enc_qei: parameter PROFILE must be in 1 .. 2");
-`endif
-    end
-    if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask
-`ifdef __ICARUS__
-      enc_qei__parameter_FUNC_MASK_must_be_1_to_511 u_stop ();
-`else
-      $error("enc_qei: parameter FUNC_MASK must be in 1 .. 511");
-`endif
-    end
+    `ENC_CHECK_COUNT_W
+    `ENC_CHECK_TS_W
+    `ENC_CHECK_PROFILE
+    `ENC_CHECK_FUNC_MASK
   endgenerate
 
   // PROFILE and FUNC_MASK as the register block's options

@@ -7,6 +7,7 @@
 // No new request starts until that response (the master still holds its strobe in its clock).
 // wb_sel_i are the byte enables of a write. All the peripheral's behaviour is in enc_qei.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei_wb #(
     parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
@@ -37,34 +38,10 @@ module enc_qei_wb #(
 );
 
   generate
-    if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w
-`ifdef __ICARUS__
-      enc_qei_wb__parameter_COUNT_W_must_be_8_to_64 u_stop ();
-`else
-      $error("enc_qei_wb: parameter COUNT_W must be in 8 .. 64");
-`endif
-    end
-    if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w
-`ifdef __ICARUS__
-      enc_qei_wb__parameter_TS_W_must_be_16_to_32 u_stop ();
-`else
-      $error("enc_qei_wb: parameter TS_W must be in 16 .. 32");
-`endif
-    end
-    if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile
-`ifdef __ICARUS__
-      enc_qei_wb__parameter_PROFILE_must_be_1_to_2 u_stop ();
-`else
-      $error("enc_qei_wb: parameter PROFILE must be in 1 .. 2");
-`endif
-    end
-    if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask
-`ifdef __ICARUS__
-      enc_qei_wb__parameter_FUNC_MASK_must_be_1_to_511 u_stop ();
-`else
-      $error("enc_qei_wb: parameter FUNC_MASK must be in 1 .. 511");
-`endif
-    end
+    `ENC_CHECK_COUNT_W
+    `ENC_CHECK_TS_W
+    `ENC_CHECK_PROFILE
+    `ENC_CHECK_FUNC_MASK
   endgenerate
 
   wire resp_valid, resp_err;

@@ -20,6 +20,7 @@
 // whole counter (overflow counting up, borrow counting down): the note's overflow flag, and the
 // cascade input for more stages.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_updown_buffer #(
     parameter integer DIGITS     = 4,   // cascaded ls168 stages: 1 .. 8
@@ -39,27 +40,9 @@ module enc_updown_buffer #(
 );
 
   generate
-    if (DIGITS < 1 || DIGITS > 8) begin : g_bad_digits
-`ifdef __ICARUS__
-      enc_updown_buffer__parameter_DIGITS_must_be_1_to_8 u_stop ();
-`else
-      $error("enc_updown_buffer: parameter DIGITS must be in 1 .. 8");
-`endif
-    end
-    if (MODULUS != 10 && MODULUS != 16) begin : g_bad_modulus
-`ifdef __ICARUS__
-      enc_updown_buffer__parameter_MODULUS_must_be_10_or_16 u_stop ();
-`else
-      $error("enc_updown_buffer: parameter MODULUS must be 10 or 16");
-`endif
-    end
-    if (FILTER_LEN < 1 || FILTER_LEN > 16) begin : g_bad_filter_len
-`ifdef __ICARUS__
-      enc_updown_buffer__parameter_FILTER_LEN_must_be_1_to_16 u_stop ();
-`else
-      $error("enc_updown_buffer: parameter FILTER_LEN must be in 1 .. 16");
-`endif
-    end
+    `ENC_CHECK_DIGITS
+    `ENC_CHECK_MODULUS
+    `ENC_CHECK_FILTER_LEN
   endgenerate
 
   wire a;

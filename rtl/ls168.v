@@ -14,6 +14,7 @@
 // q > MAX gives 0, counting down from q > MAX gives MAX, so the counter rejoins 0..MAX on the
 // first counting clock in either direction (the contract allows two). No rco_n in those states.
 `default_nettype none
+`include "enc_params.vh"
 
 module ls168 #(
     parameter integer MODULUS = 10  // 10: 'LS168 decade, 16: 'LS169 binary; nothing else
@@ -29,13 +30,7 @@ module ls168 #(
 );
 
   generate
-    if (MODULUS != 10 && MODULUS != 16) begin : g_bad_modulus
-`ifdef __ICARUS__
-      ls168__parameter_MODULUS_must_be_10_or_16 u_stop ();
-`else
-      $error("ls168: parameter MODULUS must be 10 or 16");
-`endif
-    end
+    `ENC_CHECK_MODULUS
   endgenerate
 
   localparam integer MAX_INT = MODULUS - 1;

@@ -9,7 +9,9 @@ cd "$(dirname "$0")/.."
 export PATH="$PWD/scripts/bin:$PWD/.venv/bin:$PATH"
 core() { .venv/bin/python -m enctools.core "$@"; }
 
-mapfile -t ip_files < <(core files rtl)
+mapfile -t ip_files < <(core files rtl | grep '\.v$')
+mapfile -t incdirs < <(core incdirs)
+inc=("${incdirs[@]/#/-I}")
 mapfile -t board_files < <(core files board_icebreaker)
 status=0
 checked=0
@@ -20,11 +22,11 @@ lint_one() {
   local out ivparams=() files=("${ip_files[@]}")
   case " ${board_files[*]} " in *"/$top.v "*) files+=("${board_files[@]}");; esac
   for g in "$@"; do ivparams+=("-P$top.${g#-G}"); done
-  out=$(verilator --lint-only --quiet -Wall rtl/lint_waivers.vlt --top-module "$top" "$@" "${files[@]}" 2>&1)
+  out=$(verilator --lint-only --quiet -Wall "${inc[@]}" rtl/lint_waivers.vlt --top-module "$top" "$@" "${files[@]}" 2>&1)
   if [ $? -ne 0 ] || [ -n "$out" ]; then
     echo "verilator: $top $*"; echo "$out"; status=1
   fi
-  out=$(iverilog -g2005 -Wall -o /dev/null -s "$top" "${ivparams[@]}" "${files[@]}" 2>&1)
+  out=$(iverilog -g2005 -Wall "${inc[@]}" -o /dev/null -s "$top" "${ivparams[@]}" "${files[@]}" 2>&1)
   if [ $? -ne 0 ] || [ -n "$out" ]; then
     echo "iverilog: $top $*"; echo "$out"; status=1
   fi

@@ -24,10 +24,9 @@ import pytest
 from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
-from enctools import tb as tbutil
 from enctools.harness import run
 from enctools.paths import RTL, TOP
-from enctools.tb.phase_models import (CLK_PS, LSB, Channels, Readings, off_grid, play_case, reset,
+from enctools.tb.phase_models import (CLK_PS, Channels, Readings, off_grid, play_case, reset,
                                       rises_of_a, sampled_meter_reading, start_clock, steady,
                                       waveform, window_log2, xor_phase)
 from cocotbext.quadrature import play
@@ -378,12 +377,12 @@ def test_enc_phase_meter_speed(log2, cpc, cases):
 def test_enc_phase_meter_bad_window(value, tmp_path):
     """WINDOW_LOG2 outside 8..24 stops elaboration, naming the parameter, in both simulators."""
     src = str(RTL / "enc_phase_meter.v")
-    iv = subprocess.run(["iverilog", "-g2005", "-o", str(tmp_path / "x.vvp"), "-s", "enc_phase_meter",
+    iv = subprocess.run(["iverilog", "-g2005", f"-I{RTL}", "-o", str(tmp_path / "x.vvp"), "-s", "enc_phase_meter",
                          f"-Penc_phase_meter.WINDOW_LOG2={value}", src], capture_output=True, text=True)
     assert iv.returncode != 0, "iverilog built an out-of-range WINDOW_LOG2"
     assert "WINDOW_LOG2" in iv.stdout + iv.stderr
     env = dict(os.environ, PATH=f"{TOP / 'scripts' / 'bin'}{os.pathsep}{os.environ.get('PATH', '')}")
-    vl = subprocess.run(["verilator", "--lint-only", "--top-module", "enc_phase_meter",
+    vl = subprocess.run(["verilator", "--lint-only", f"-I{RTL}", "--top-module", "enc_phase_meter",
                          f"-GWINDOW_LOG2={value}", src], capture_output=True, text=True, env=env)
     assert vl.returncode != 0, "verilator accepted an out-of-range WINDOW_LOG2"
     assert "WINDOW_LOG2" in vl.stdout + vl.stderr

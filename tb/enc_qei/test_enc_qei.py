@@ -20,7 +20,8 @@ from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitch
 
 from enctools.harness import run
 from enctools.qei.model import FUNCS, RANGES, QeiModel
-from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, event_bits, pack, regmap, size_mask
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
+from enctools.regmap import event_bits, pack, regmap, size_mask
 from enctools.tb import cocotb_test, start
 
 FILTER = 2  # FILTER_LEN for the walks; states last >= 1.05 FILTER clocks

@@ -21,7 +21,8 @@ from enctools.tb import cocotb_test
 from enctools.harness import run
 from hedsmodel import QUAD, random_walk, walk, with_glitches
 from enctools.qei.model import QeiModel
-from enctools.qei.bus import (PERIOD_PS, T_NS, event_bits, pack, play_clocks, regmap, size_mask,
+from enctools.regmap import event_bits, pack, regmap, size_mask
+from enctools.qei.bus import (PERIOD_PS, T_NS, play_clocks,
                     step_clocks)
 from test_enc_qei import begin, durations
 

@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from enctools.core import files_for, guard_cases
+from enctools.core import files_for, guard_cases, include_dirs
 from enctools.paths import TOP
 from enctools.harness import sim_name
 
@@ -16,7 +16,7 @@ CASES = list(guard_cases())
 
 
 def elaborate(path: str, module: str, param: str, value: int) -> subprocess.CompletedProcess:
-    sources = [str(TOP / f) for f in files_for(path)]
+    sources = [str(TOP / f) for f in files_for(path)] + [f"-I{d}" for d in include_dirs()]
     if sim_name() == "icarus":
         cmd = ["iverilog", "-g2012", "-o", "/dev/null", "-s", module, f"-P{module}.{param}={value}"]
     else:

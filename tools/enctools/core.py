@@ -51,6 +51,13 @@ def include_dirs() -> list[Path]:
     return sorted({(TOP / f).parent for f in include_files()})
 
 
+def yosys_read(files: list[str], defer: bool = True) -> str:
+    """A Yosys `read_verilog` of repository files with the include folders (paths relative to
+    the repository top, as YoWASP's Yosys needs)."""
+    incs = " ".join(f"-I{d.relative_to(TOP)}" for d in include_dirs())
+    return f"read_verilog {'-defer ' if defer else ''}{incs} {' '.join(files)}"
+
+
 def board_files(board: str = "icebreaker") -> list[str]:
     return fileset(f"board_{board}")
 

@@ -19,7 +19,6 @@ import tempfile
 import time
 from pathlib import Path
 
-from .paths import TOP
 
 
 def positive(kind):

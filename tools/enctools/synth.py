@@ -231,9 +231,10 @@ def rel(path: Path, cwd: Path) -> str:
 
 def yosys_script(block: Block, out: Path, json_out: Path, stat_out: Path) -> str:
     files = " ".join(rel(p, out) for p in rtl_files(block))
+    incs = " ".join(f"-I{rel(d, out)}" for d in core_file.include_dirs())
     chparams = " ".join(f"-chparam {k} {v}" for k, v in block.params.items())
     return "\n".join([
-        f"read_verilog -defer {files}",
+        f"read_verilog -defer {incs} {files}",
         f"hierarchy -check -top {block.name} {chparams}",
         "proc",
         # an inferred latch is a design error in this library: fail on any

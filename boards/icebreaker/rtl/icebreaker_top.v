@@ -38,6 +38,7 @@
 // 16 clocks, and the user button asserts it while pressed (synchronized). All blocks reset
 // synchronously from that.
 `default_nettype none
+`include "enc_params.vh"
 
 module icebreaker_top #(
     parameter integer CLK_HZ            = 12_000_000,  // clk frequency: >= 2 * BAUD
@@ -58,6 +59,7 @@ module icebreaker_top #(
 );
 
   generate
+    // (BAUD and LINE_HZ are bounded by CLK_HZ, a relation enc_ip.core's ranges cannot hold)
     if (CLK_HZ < 2 * BAUD || BAUD < 1) begin : g_bad_baud
 `ifdef __ICARUS__
       icebreaker_top__parameter_BAUD_must_be_1_to_CLK_HZ_over_2 u_stop ();
@@ -72,13 +74,7 @@ module icebreaker_top #(
       $error("icebreaker_top: parameter LINE_HZ must be in 1 .. CLK_HZ/64");
 `endif
     end
-    if (POS_WIDTH < 8 || POS_WIDTH > 31) begin : g_bad_pos_width
-`ifdef __ICARUS__
-      icebreaker_top__parameter_POS_WIDTH_must_be_8_to_31 u_stop ();
-`else
-      $error("icebreaker_top: parameter POS_WIDTH must be in 8 .. 31");
-`endif
-    end
+    `ENC_CHECK_POS_WIDTH
   endgenerate
 
   // ---- sizes -------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 // long, and `ready` returns high once the stop bit has been sent. `tx` idles high, and is high
 // from the clock after `rst` (a synchronous reset, active high).
 `default_nettype none
+`include "enc_params.vh"
 
 module uart_tx #(
     parameter integer CLKS_PER_BIT = 104  // clocks per bit (clock / baud): 2 .. 65535
@@ -20,13 +21,7 @@ module uart_tx #(
 );
 
   generate
-    if (CLKS_PER_BIT < 2 || CLKS_PER_BIT > 65535) begin : g_bad_clks_per_bit
-`ifdef __ICARUS__
-      uart_tx__parameter_CLKS_PER_BIT_must_be_2_to_65535 u_stop ();
-`else
-      $error("uart_tx: parameter CLKS_PER_BIT must be in 2 .. 65535");
-`endif
-    end
+    `ENC_CHECK_CLKS_PER_BIT
   endgenerate
 
   localparam integer DW = (CLKS_PER_BIT <= 2) ? 1 : $clog2(CLKS_PER_BIT);  // bit-timer width

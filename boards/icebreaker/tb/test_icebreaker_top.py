@@ -42,7 +42,7 @@ from enctools.paths import TOP
 from enctools.harness import run
 from cocotbext.quadrature import play
 from hedsmodel.waveform import QUAD, STATE_TO_POS, Waveform
-from enctools.qei.bus import addr, event_bits, get_field, pack
+from enctools.regmap import addr, event_bits, get_field, pack
 from enctools.tb import cocotb_test, log_seed
 
 CLK_HZ = 12_000_000

@@ -21,7 +21,8 @@ from cocotb.triggers import ClockCycles
 
 from cocotbext.quadrature import QuadratureDriver
 from hedsmodel.waveform import random_walk
-from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, pack
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
+from enctools.regmap import pack
 from enctools.tb import cocotb_test, reset_dut, start
 
 

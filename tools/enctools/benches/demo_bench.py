@@ -32,7 +32,8 @@ from cocotbext.quadrature import play
 
 from enctools.tb import cocotb_test
 from hedsmodel.waveform import Waveform
-from enctools.qei.bus import QeiBus, get_field, pack  # tb/enc_qei/ (on the runner's path via harness)
+from enctools.qei.bus import QeiBus
+from enctools.regmap import get_field, pack
 
 QEI_READS = ("SNAP_COUNT_LO", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA",
              "STATUS")

@@ -49,6 +49,7 @@ OUT_H = TOP / "sw" / "enc_qei_regs.h"
 OUT_MD = TOP / "doc" / "enc_qei_regs.md"
 OUT_V = TOP / "rtl" / "enc_qei_regs.v"
 OUT_VH = TOP / "rtl" / "enc_qei_regs.vh"
+OUT_PARAMS = TOP / "rtl" / "enc_params.vh"
 
 SIZE_MASKS = {"COUNT_W:0": "SZ_COUNT_LO", "COUNT_W:1": "SZ_COUNT_HI", "TS_W": "SZ_TS"}
 
@@ -378,6 +379,10 @@ def generate(out_dir: Path | None = None) -> dict[Path, Path]:
     vh = (out_dir / OUT_VH.name) if out_dir else OUT_VH
     vh.write_text(regs_vh.render(top))
     written[OUT_VH] = vh
+    from . import params_vh
+    pv = (out_dir / OUT_PARAMS.name) if out_dir else OUT_PARAMS
+    pv.write_text(params_vh.render())
+    written[OUT_PARAMS] = pv
     return written
 
 

@@ -8,8 +8,7 @@ from __future__ import annotations
 import logging
 import random
 
-from enctools.regmap import (addr, enum, event_bits, event_names, field_val, get_field, pack,  # noqa: F401
-                             regmap, size_mask)
+from enctools.regmap import addr, event_names
 
 PERIOD_PS = 10_000  # 100 MHz
 T_NS = PERIOD_PS / 1000
