@@ -23,29 +23,31 @@
 // RANGE and the index controls (INDEX_CTRL: ACTION, ARM, ONESHOT) act one clock after they change.
 // CEILING: the range uses the ceiling input as of two clocks earlier (a CEILING write acts two
 // clocks after it; the core keeps a pipeline of it so that count >= CEILING is a flag register).
-// COUNT_LO writes load the count two clocks after their strobe (the value: the written low word
-// and the staged high word of the strobe's clock); an index preset loads PRESET of the clock
-// before (both registered in the core with their comparisons, for Fmax).
+// A load (a COUNT write: the register block assembles the value) loads the count two clocks after
+// its strobe, with the value given with the strobe; an index preset loads PRESET of the clock
+// before (both registered in the core with their comparisons, for Fmax). Loads and presets act
+// whatever EN is.
 // x1_hyst (Figure 14) is proven in formal/enc_x1_hysteresis.sby; here its steps are taken from the
 // core's step ports (only "never both" and EN gating are checked), the range model still applies
 // them independently.
-// Index: Z after INV_Z, qualified by the (A, B) gate, edge detector held in reset by rst | !valid,
-// its hit in clock t + 2 (with the step of the same sample); an armed preset wins over the step, a
-// latch stores the count after the step. Probe: edge of probe_c, hit one clock after the sample
+// Index: Z after INV_Z, qualified by the (A, B) gate, edge detector held in reset by rst | !valid;
+// no edge in a clock where {SWAP_AB, INV_A, INV_B, INV_Z} differs from the clock before (the level
+// change a configuration write makes is not an index edge); its hit in clock t + 2 (with the step
+// of the same sample); an armed preset wins over the step, a latch stores the count after the step. Probe: edge of probe_c, hit one clock after the sample
 // (held in reset likewise), latches the count and the timebase of that clock.
-// Checked: count, STOPPED, dir, COUNT_LO/HI read data, step and edge outputs, every event output
-// (overflow, underflow, index, probe, cmp, qerr, dir_change), applied_up/dn, idx_armed,
-// idx_disarm, probe_disarm, INDEX_LATCH, PROBE_LATCH and PROBE_TIME equal the model at every
-// clock; plus model-free one-step properties (applied steps move the count by exactly one in the
-// range; the count changes only by a step, a COUNT_LO write or an index preset; a bounded range is
-// never left; non_recycle stays stopped until a COUNT_LO write) and, with COUNT_W > 32, LO/HI
-// coherence. Task X4FREE (define) assumes x4, free range, EN, no COUNT write, no index preset and
-// checks count == a plain 4X position of the sample stream directly.
+// Checked: count, STOPPED, dir, step and edge outputs, every event output (overflow, underflow,
+// index, probe, cmp, qerr, dir_change), applied_up/dn, idx_armed, idx_disarm, probe_disarm,
+// INDEX_LATCH, PROBE_LATCH and PROBE_TIME equal the model at every clock; plus model-free
+// one-step properties (applied steps move the count by exactly one in the range; the count
+// changes only by a step, a load or an index preset; a bounded range is never left; non_recycle
+// stays stopped until a load). Task X4FREE (define) assumes x4, free range, EN, no load, no index
+// preset and checks count == a plain 4X position of the sample stream directly. (The 32-bit LO/HI
+// words of the count are the register block's: formal/enc_qei_regs.sby.)
 // Defines: PIPE_ONLY keeps only what does not depend on the count register (k-induction closes on
 // it from the ports alone); the count's induction needs the core's internal zero_q flag to agree
 // with count_q, an invariant the ports cannot show, so those properties run bounded (see the .sby).
-// HI_STAGED assumes each COUNT_LO write follows a COUNT_HI write (for the COUNT_W 40 induction:
-// the staged word is invisible otherwise).
+// Codes of CTRL.FUNC, CTRL.RANGE and INDEX_CTRL.ACTION: rtl/enc_qei_regs.vh (generated from the
+// RDL).
 `default_nettype none
 
 module enc_qei_core_formal #(
@@ -80,15 +82,10 @@ module enc_qei_core_formal #(
     input wire               probe_edge,
     input wire               probe_once,
     input wire [TS_W-1:0]    timebase,
-    input wire               count_lo_rd,
-    input wire               count_lo_wr,
-    input wire [31:0]        count_lo_wdata,
-    input wire               count_hi_wr,
-    input wire [31:0]        count_hi_wdata
+    input wire               load,
+    input wire [COUNT_W-1:0] load_value
 );
 
-  wire [31:0]        count_lo_rdata;
-  wire [31:0]        count_hi_rdata;
   wire [COUNT_W-1:0] count;
   wire [COUNT_W-1:0] idx_latch;
   wire [COUNT_W-1:0] probe_latch;
@@ -129,13 +126,8 @@ module enc_qei_core_formal #(
       .probe_edge    (probe_edge),
       .probe_once    (probe_once),
       .timebase      (timebase),
-      .count_lo_rd   (count_lo_rd),
-      .count_lo_wr   (count_lo_wr),
-      .count_lo_wdata(count_lo_wdata),
-      .count_hi_wr   (count_hi_wr),
-      .count_hi_wdata(count_hi_wdata),
-      .count_lo_rdata(count_lo_rdata),
-      .count_hi_rdata(count_hi_rdata),
+      .load          (load),
+      .load_value    (load_value),
       .count         (count),
       .idx_latch     (idx_latch),
       .probe_latch   (probe_latch),
@@ -164,10 +156,7 @@ module enc_qei_core_formal #(
       .cmp_out       (cmp_out)
   );
 
-  localparam [3:0] F_X4 = 4'd0, F_X2A = 4'd1, F_X2B = 4'd2, F_X1A = 4'd3, F_X1B = 4'd4,
-                   F_PULSE_DIR = 4'd5, F_INCREASE = 4'd6, F_DECREASE = 4'd7, F_X1_HYST = 4'd8;
-  localparam [1:0] R_FREE = 2'd0, R_MODULO = 2'd1, R_LIMIT = 2'd2, R_NON_RECYCLE = 2'd3;
-  localparam [1:0] I_PRESET = 2'd1;
+  `include "enc_qei_regs.vh"
   localparam [COUNT_W-1:0] ONE = {{(COUNT_W-1){1'b0}}, 1'b1};
   localparam [COUNT_W-1:0] ZERO = {COUNT_W{1'b0}};
   localparam [COUNT_W-1:0] ALL1 = {COUNT_W{1'b1}};
@@ -193,28 +182,19 @@ module enc_qei_core_formal #(
 `ifdef X4FREE
   // Task prove_x4free: x4, free range, counting enabled, no COUNT write, no index preset.
   always @(*) begin
-    assume (func == F_X4 && range == R_FREE && en && !count_lo_wr && idx_action != I_PRESET);
+    assume (func == ENC_QEI_FUNC_X4 && range == ENC_QEI_RANGE_FREE && en && !load &&
+            idx_action != ENC_QEI_INDEX_ACTION_PRESET);
   end
 `endif
-
-`ifdef HI_STAGED
-  // Task prove_w40: a COUNT_LO write comes the clock after a COUNT_HI write (the staged high word
-  // is internal state the ports do not show until a COUNT_LO write uses it; this keeps it known
-  // to the induction). Writes in any order are proven at COUNT_W 8 and 16.
-  always @(*) begin
-    if (f_past_valid && count_lo_wr) assume (f_hi_wr_q);
-  end
-`endif
-  reg f_hi_wr_q = 1'b0;
-  always @(posedge clk) f_hi_wr_q <= count_hi_wr;
 
   // ---- sample level (clock t) ----------------------------------------------------------------------
   wire       f_a = (swap_ab ? b_c : a_c) ^ inv_a;
   wire       f_b = (swap_ab ? a_c : b_c) ^ inv_b;
   wire       f_z = z_c ^ inv_z;
-  wire [6:0] f_cfg = {func, swap_ab, inv_a, inv_b};
-  reg  [6:0] f_cfg_q = 7'd0;  // the clock before (cleared by rst)
-  wire       f_drst = rst | ~valid | (f_cfg != f_cfg_q);  // decoders held in reset
+  wire [7:0] f_cfg = {func, swap_ab, inv_a, inv_b, inv_z};
+  reg  [7:0] f_cfg_q = 8'd0;  // the clock before (cleared by rst)
+  wire       f_drst = rst | ~valid | (f_cfg[7:1] != f_cfg_q[7:1]);  // decoders held in reset
+  wire       f_zref = (f_cfg[3:0] != f_cfg_q[3:0]);  // the index re-referenced: no edge
 
   reg        f_ref = 1'b0;      // the previous sample is a real one (decoders out of reset)
   reg  [1:0] f_prev = 2'b00;    // previous {a, b}
@@ -234,7 +214,7 @@ module enc_qei_core_formal #(
   reg f1_a = 1'b0, f1_b = 1'b0, f1_arise = 1'b0;
 
   always @(posedge clk) begin
-    f_cfg_q    <= rst ? 7'd0 : f_cfg;
+    f_cfg_q    <= rst ? 8'd0 : f_cfg;
     f_ref      <= ~f_drst;
     f_prev     <= {f_a, f_b};
     f1_valid   <= f_valid;
@@ -253,7 +233,7 @@ module enc_qei_core_formal #(
     end else begin
       f_iprev <= f_iq;
       f_iok   <= 1'b1;
-      f_ihit1 <= f_iok & (idx_edge ? (f_iprev & ~f_iq) : (~f_iprev & f_iq));
+      f_ihit1 <= f_iok & ~f_zref & (idx_edge ? (f_iprev & ~f_iq) : (~f_iprev & f_iq));
       f_ihit  <= f_ihit1;
     end
   end
@@ -265,38 +245,38 @@ module enc_qei_core_formal #(
     f_fdn  = 1'b0;
     f_quad = 1'b0;
     case (func)
-      F_X4: begin
+      ENC_QEI_FUNC_X4: begin
         f_fup = f1_valid & f1_fwd;
         f_fdn = f1_valid & ~f1_fwd;
         f_quad = 1'b1;
       end
-      F_X2A: begin  // both edges of A
+      ENC_QEI_FUNC_X2A: begin  // both edges of A
         f_fup = f1_valid & f1_amov & f1_fwd;
         f_fdn = f1_valid & f1_amov & ~f1_fwd;
         f_quad = 1'b1;
       end
-      F_X2B: begin
+      ENC_QEI_FUNC_X2B: begin
         f_fup = f1_valid & f1_bmov & f1_fwd;
         f_fdn = f1_valid & f1_bmov & ~f1_fwd;
         f_quad = 1'b1;
       end
-      F_X1A: begin  // +1 on A rising forward, -1 on A falling backward
+      ENC_QEI_FUNC_X1A: begin  // +1 on A rising forward, -1 on A falling backward
         f_fup = f1_valid & f1_amov & f1_fwd & f1_a;
         f_fdn = f1_valid & f1_amov & ~f1_fwd & ~f1_a;
         f_quad = 1'b1;
       end
-      F_X1B: begin
+      ENC_QEI_FUNC_X1B: begin
         f_fup = f1_valid & f1_bmov & f1_fwd & f1_b;
         f_fdn = f1_valid & f1_bmov & ~f1_fwd & ~f1_b;
         f_quad = 1'b1;
       end
-      F_PULSE_DIR: begin  // A rising, B = direction (1 = up)
+      ENC_QEI_FUNC_PULSE_DIR: begin  // A rising, B = direction (1 = up)
         f_fup = f1_arise & f1_b;
         f_fdn = f1_arise & ~f1_b;
       end
-      F_INCREASE: f_fup = f1_arise;
-      F_DECREASE: f_fdn = f1_arise;
-      F_X1_HYST: f_quad = 1'b1;  // steps: see f_hyst_q
+      ENC_QEI_FUNC_INCREASE: f_fup = f1_arise;
+      ENC_QEI_FUNC_DECREASE: f_fdn = f1_arise;
+      ENC_QEI_FUNC_X1_HYST: f_quad = 1'b1;  // steps: see f_hyst_q
       default: ;
     endcase
   end
@@ -315,7 +295,7 @@ module enc_qei_core_formal #(
       f2_dn         <= en & f_fdn;
       f2_edge       <= f1_valid;
       f2_arise_edge <= f1_valid & f1_amov & f1_a;
-      f_hyst_q      <= en & (func == F_X1_HYST);
+      f_hyst_q      <= en & (func == ENC_QEI_FUNC_X1_HYST);
     end
   end
 
@@ -326,8 +306,6 @@ module enc_qei_core_formal #(
   reg  [COUNT_W-1:0] f_count = {COUNT_W{1'b0}};
   reg                f_stopped = 1'b0;
   reg                f_dir = 1'b1;
-  reg  [31:0]        f_hi_stage = 32'd0;
-  reg  [31:0]        f_hi_latch = 32'd0;
   reg                f_upd_q = 1'b0;
   reg                f_cmp = 1'b0;
 
@@ -350,43 +328,43 @@ module enc_qei_core_formal #(
     f_stop_d  = f_stopped;
     if (f_su) begin
       case (f_range)
-        R_FREE: begin
+        ENC_QEI_RANGE_FREE: begin
           f_stepped = f_count + ONE;
           f_ovf = (f_count == ALL1);
           f_took = 1'b1;
         end
-        R_MODULO: begin
+        ENC_QEI_RANGE_MODULO: begin
           f_stepped = f_at_ceil ? ZERO : f_count + ONE;
           f_ovf = f_at_ceil;
           f_took = 1'b1;
         end
         default: begin  // limit, non_recycle (while not stopped)
-          if (f_range == R_LIMIT || !f_stopped) begin
+          if (f_range == ENC_QEI_RANGE_LIMIT || !f_stopped) begin
             f_stepped = f_at_ceil ? f_count : f_count + ONE;
             f_ovf = f_at_ceil;
             f_took = ~f_at_ceil;
-            if (f_range == R_NON_RECYCLE) f_stop_d = f_at_ceil;
+            if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_ceil;
           end
         end
       endcase
     end else if (f_sd) begin
       case (f_range)
-        R_FREE: begin
+        ENC_QEI_RANGE_FREE: begin
           f_stepped = f_count - ONE;
           f_unf = f_at_zero;
           f_took = 1'b1;
         end
-        R_MODULO: begin
+        ENC_QEI_RANGE_MODULO: begin
           f_stepped = f_at_zero ? f_ceil : f_count - ONE;
           f_unf = f_at_zero;
           f_took = 1'b1;
         end
         default: begin
-          if (f_range == R_LIMIT || !f_stopped) begin
+          if (f_range == ENC_QEI_RANGE_LIMIT || !f_stopped) begin
             f_stepped = f_at_zero ? f_count : f_count - ONE;
             f_unf = f_at_zero;
             f_took = ~f_at_zero;
-            if (f_range == R_NON_RECYCLE) f_stop_d = f_at_zero;
+            if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_zero;
           end
         end
       endcase
@@ -394,41 +372,34 @@ module enc_qei_core_formal #(
     if (f_lw_q) f_stop_d = 1'b0;  // a COUNT write releases non_recycle
   end
 
-  wire               f_armed = f_arm & (f_act != 2'd0);
-  wire               f_preset = f_ihit & f_armed & (f_act == I_PRESET);
-  wire [63:0]        f_wr64 = {f_hi_stage, count_lo_wdata};  // the value a COUNT_LO write loads
-  wire [COUNT_W-1:0] f_wr = f_wr64[COUNT_W-1:0];
-  // a COUNT_LO write loads the count two clocks after its strobe (f_lw_q, f_wr_q), an index preset
-  // loads PRESET as it was one clock earlier (f_pre_q)
+  wire               f_armed = f_arm & (f_act != ENC_QEI_INDEX_ACTION_NONE);
+  wire               f_preset = f_ihit & f_armed & (f_act == ENC_QEI_INDEX_ACTION_PRESET);
+  // a load loads the count two clocks after its strobe (f_lw_q, f_wr_q), an index preset loads
+  // PRESET as it was one clock earlier (f_pre_q)
   reg                f_lw1_q = 1'b0, f_lw_q = 1'b0;
   reg  [COUNT_W-1:0] f_wr1_q = {COUNT_W{1'b0}}, f_wr_q = {COUNT_W{1'b0}};
   reg  [COUNT_W-1:0] f_pre_q = {COUNT_W{1'b0}};
   always @(posedge clk) begin
-    f_lw1_q <= ~rst & count_lo_wr;
+    f_lw1_q <= ~rst & load;
     f_lw_q  <= ~rst & f_lw1_q;
-    f_wr1_q <= f_wr;
+    f_wr1_q <= load_value;
     f_wr_q  <= f_wr1_q;
     f_pre_q <= preset;
   end
   wire               f_load = f_lw_q | f_preset;
   wire [COUNT_W-1:0] f_next = f_lw_q ? f_wr_q : f_preset ? f_pre_q : f_stepped;
-  wire [63:0]        f_count64 = {{(64 - COUNT_W) {1'b0}}, f_count};
 
   always @(posedge clk) begin
     if (rst) begin
       f_count    <= ZERO;
       f_stopped  <= 1'b0;
       f_dir      <= 1'b1;
-      f_hi_stage <= 32'd0;
-      f_hi_latch <= 32'd0;
       f_upd_q    <= 1'b0;
       f_cmp      <= 1'b0;
     end else begin
       f_count   <= f_next;
       f_stopped <= f_stop_d;
       if (f_su | f_sd) f_dir <= f_su;
-      if (count_hi_wr) f_hi_stage <= count_hi_wdata;
-      if (count_lo_rd) f_hi_latch <= f_count64[63:32];
       f_upd_q   <= f_load | f_took;  // the count was set (changed or reloaded) at this edge
       f_cmp     <= f_upd_q & (f_count == compare);
     end
@@ -438,7 +409,7 @@ module enc_qei_core_formal #(
   reg  f_pprev = 1'b0, f_pok = 1'b0, f_phit = 1'b0;
   reg  [COUNT_W-1:0] f_idx_latch = {COUNT_W{1'b0}}, f_probe_latch = {COUNT_W{1'b0}};
   reg  [TS_W-1:0]    f_probe_time = {TS_W{1'b0}};
-  wire f_ilatch = f_ihit & f_armed & (f_act == 2'd2);
+  wire f_ilatch = f_ihit & f_armed & (f_act == ENC_QEI_INDEX_ACTION_LATCH);
   always @(posedge clk) begin
     if (rst | ~valid) begin
       f_pprev <= 1'b0;
@@ -487,9 +458,6 @@ module enc_qei_core_formal #(
       assert (ev_dir_change == ((f_su & ~f_dir) | (f_sd & f_dir)));
 `ifndef PIPE_ONLY
       assert (ev_cmp == f_cmp && cmp_out == f_cmp);
-      // COUNT_LO reads the count's low word; COUNT_HI what the last COUNT_LO read latched
-      assert (count_lo_rdata == f_count64[31:0]);
-      assert (count_hi_rdata == f_hi_latch);
 `endif
       assert (ev_probe == f_phit && probe_disarm == (f_phit & probe_once));
       assert (probe_time == f_probe_time);
@@ -497,7 +465,6 @@ module enc_qei_core_formal #(
       assert (idx_latch == f_idx_latch);
       assert (probe_latch == f_probe_latch);
 `endif
-      if (COUNT_W <= 32) assert (count_hi_rdata == 32'd0);
     end
   end
 
@@ -507,51 +474,34 @@ module enc_qei_core_formal #(
     if (f_past_valid && !$past(rst)) begin
       // an applied step moves the count by exactly one, in the range
       if ($past(applied_up))
-        assert (count == (($past(f_range) == R_MODULO && $past(count) >= $past(f_ceil)) ? ZERO :
+        assert (count == (($past(f_range) == ENC_QEI_RANGE_MODULO && $past(count) >= $past(f_ceil)) ? ZERO :
                           $past(count) + ONE));
       if ($past(applied_dn))
-        assert (count == (($past(f_range) == R_MODULO && $past(count) == ZERO) ? $past(f_ceil) :
+        assert (count == (($past(f_range) == ENC_QEI_RANGE_MODULO && $past(count) == ZERO) ? $past(f_ceil) :
                           $past(count) - ONE));
       assert (!$past(applied_up && applied_dn));
-      // the count changes only by a step, a COUNT_LO write or an index preset
+      // the count changes only by a step, a load or an index preset
       if (!$past(applied_up || applied_dn || f_lw_q || f_preset)) assert (count == $past(count));
       if ($past(f_lw_q)) assert (count == $past(f_wr_q));
       // a bounded range is never left by counting
-      if ($past(f_range) != R_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
+      if ($past(f_range) != ENC_QEI_RANGE_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
         assert (count <= $past(f_ceil));
       // limit / non_recycle: never past the bounds, the stop raises the event and is no step
-      if ($past(f_range) == R_LIMIT || $past(f_range) == R_NON_RECYCLE) begin
+      if ($past(f_range) == ENC_QEI_RANGE_LIMIT || $past(f_range) == ENC_QEI_RANGE_NON_RECYCLE) begin
         if ($past(step_up) && $past(count) >= $past(f_ceil))
-          assert (!$past(applied_up) && $past(ev_overflow) == ($past(f_range) == R_LIMIT || !$past(stopped)));
+          assert (!$past(applied_up) && $past(ev_overflow) == ($past(f_range) == ENC_QEI_RANGE_LIMIT || !$past(stopped)));
         if ($past(step_dn) && !$past(step_up) && $past(count) == ZERO)
-          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(f_range) == R_LIMIT || !$past(stopped)));
+          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(f_range) == ENC_QEI_RANGE_LIMIT || !$past(stopped)));
       end
-      // non_recycle: stopped stays stopped (and the count still) until a COUNT_LO write
+      // non_recycle: stopped stays stopped (and the count still) until a load
       if ($past(stopped) && !$past(f_lw_q)) assert (stopped);
-      if ($past(stopped) && $past(f_range) == R_NON_RECYCLE && !$past(f_load))
+      if ($past(stopped) && $past(f_range) == ENC_QEI_RANGE_NON_RECYCLE && !$past(f_load))
         assert (count == $past(count) && !$past(applied_up || applied_dn));
       if ($past(f_lw_q)) assert (!stopped);
     end
   end
 
 `endif
-
-  // ---- LO/HI coherence (meaningful with COUNT_W > 32) ----------------------------------------------
-  reg [63:0] f_read = 64'd0;  // the count as of the last COUNT_LO read (0 after rst)
-  always @(posedge clk) begin
-    if (rst) f_read <= 64'd0;
-    else if (count_lo_rd) f_read <= f_count64;
-  end
-  always @(*) begin
-    if (f_past_valid) begin
-`ifdef PIPE_ONLY
-      if (COUNT_W <= 32) assert (count_hi_rdata == 32'd0);
-`else
-      assert (count_hi_rdata == f_read[63:32]);
-      if (count_lo_rd) assert ({32'd0, count_lo_rdata} == {32'd0, f_count64[31:0]});
-`endif
-    end
-  end
 
 `ifdef X4FREE
   // ---- x4 in the free range: count == a plain 4X position of the sample stream ---------------------
@@ -581,33 +531,33 @@ module enc_qei_core_formal #(
   // ---- covers: every property's situation is reached ---------------------------------------------
   always @(posedge clk) begin
     if (f_past_valid && !rst) begin
-      cover (func == F_X4 && f_range == R_FREE && applied_up && count == ONE);
-      cover (func == F_X4 && f_range == R_FREE && applied_dn && count == ZERO);
-      cover (f_range == R_FREE && ev_overflow && applied_up);
-      cover (f_range == R_FREE && ev_underflow && applied_dn);
-      cover (f_range == R_MODULO && ev_overflow && applied_up && count != ZERO);
-      cover (f_range == R_MODULO && ev_underflow && applied_dn && f_ceil != ALL1);
-      cover (f_range == R_LIMIT && ev_overflow && step_up && count == f_ceil && f_ceil != ALL1);
-      cover (f_range == R_LIMIT && ev_underflow && step_dn);
-      cover (f_range == R_NON_RECYCLE && ev_overflow && !stopped && f_ceil != ALL1);
-      cover (f_range == R_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
+      cover (func == ENC_QEI_FUNC_X4 && f_range == ENC_QEI_RANGE_FREE && applied_up && count == ONE);
+      cover (func == ENC_QEI_FUNC_X4 && f_range == ENC_QEI_RANGE_FREE && applied_dn && count == ZERO);
+      cover (f_range == ENC_QEI_RANGE_FREE && ev_overflow && applied_up);
+      cover (f_range == ENC_QEI_RANGE_FREE && ev_underflow && applied_dn);
+      cover (f_range == ENC_QEI_RANGE_MODULO && ev_overflow && applied_up && count != ZERO);
+      cover (f_range == ENC_QEI_RANGE_MODULO && ev_underflow && applied_dn && f_ceil != ALL1);
+      cover (f_range == ENC_QEI_RANGE_LIMIT && ev_overflow && step_up && count == f_ceil && f_ceil != ALL1);
+      cover (f_range == ENC_QEI_RANGE_LIMIT && ev_underflow && step_dn);
+      cover (f_range == ENC_QEI_RANGE_NON_RECYCLE && ev_overflow && !stopped && f_ceil != ALL1);
+      cover (f_range == ENC_QEI_RANGE_NON_RECYCLE && stopped && step_dn);  // a step while stopped: ignored
       cover ($past(stopped) && f_lw_q && !rst);               // released by a COUNT_LO write
-      cover (ev_qerr && func == F_X4);
+      cover (ev_qerr && func == ENC_QEI_FUNC_X4);
       cover (ev_dir_change && step_dn);
       cover (ev_dir_change && step_up);
       cover (ev_cmp && $past(applied_up));
       cover (ev_cmp && $past(f_lw_q, 2));
       cover (ev_cmp && $past(f_preset, 2));
       cover (f_preset && (step_up | step_dn));                 // a preset wins over the step
-      cover (func == F_X2A && applied_dn);
-      cover (func == F_X2B && applied_up);
-      cover (func == F_X1A && applied_dn);
-      cover (func == F_X1B && applied_up);
-      cover (func == F_PULSE_DIR && applied_dn);
-      cover (func == F_INCREASE && applied_up);
-      cover (func == F_DECREASE && applied_dn);
+      cover (func == ENC_QEI_FUNC_X2A && applied_dn);
+      cover (func == ENC_QEI_FUNC_X2B && applied_up);
+      cover (func == ENC_QEI_FUNC_X1A && applied_dn);
+      cover (func == ENC_QEI_FUNC_X1B && applied_up);
+      cover (func == ENC_QEI_FUNC_PULSE_DIR && applied_dn);
+      cover (func == ENC_QEI_FUNC_INCREASE && applied_up);
+      cover (func == ENC_QEI_FUNC_DECREASE && applied_dn);
       cover (f_hyst_q && applied_up);
-      cover (count_lo_rd && count != ZERO);
+      cover (load && count != ZERO);
       cover (f_ilatch && (step_up | step_dn));  // INDEX_LATCH takes the stepped count
       cover (ev_probe && count != ZERO && probe_time != {TS_W{1'b0}});
     end

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// enc_conditioner_rt -- enc_conditioner with the filter length as a run-time input.
+// enc_conditioner_rt -- the input synchronizer and digital filter of the two encoder channels,
+// with the filter length as a run-time input (enc_qei's CTRL.FILTER_LEN). enc_conditioner, the
+// contract's fixed-length block, is this module with the length tied to its FILTER_LEN.
 //
-// Same circuit, same timing and same outputs as enc_conditioner at the same length: per channel
+// Per channel:
 //   a_in -> two flip-flops (synchronizer) -> filter_len-sample filter -> a
 // The filter output takes a new level only after the synchronized input has shown that level on
 // filter_len consecutive clocks; a level that goes back sooner is rejected and `glitch` pulses
@@ -12,9 +14,7 @@
 // acts from the clock after it appears (the reset value is in place when rst falls, so the
 // timings above hold from reset). It may change at any time: a
 // candidate level already seen on at least the new length of samples is accepted at the next
-// differing sample, so a change never loses or invents a level. enc_conditioner is this module
-// with filter_len tied to FILTER_LEN and MAX_FILTER_LEN = FILTER_LEN (then the run counter and
-// the settling chain are exactly as wide as the fixed-length circuit's).
+// differing sample, so a change never loses or invents a level.
 `default_nettype none
 `include "enc_params.vh"
 
@@ -163,6 +163,26 @@ module enc_conditioner_rt #(
   assign b      = level[1];
   assign glitch = glitch_q;
   assign valid  = valid_d;
+
+`ifdef FORMAL
+  // ---- formal only (formal/enc_conditioner_rt.sby, enc_conditioner.sby): invariants, asserts
+  // only. The port-level properties are in the formal wrappers. These bound the registers to
+  // their reachable values so that induction (here and in a parent) needs no long traces: each
+  // run-length counter stays below MAX_FILTER_LEN, and the settling chain fills with ones from
+  // bit 0 (a thermometer code).
+  reg f_rst_seen = 1'b0;  // a rst has happened: the registers are defined
+  always @(posedge clk) begin
+    if (rst) f_rst_seen <= 1'b1;
+  end
+
+  always @(*) begin
+    if (f_rst_seen) begin
+      assert ({1'b0, g_filter[0].run_q} <= MAX_LAST_INT && {1'b0, g_filter[1].run_q} <= MAX_LAST_INT);
+      assert (((settle_q >> 1) & ~settle_q) == {SETTLE{1'b0}});
+      assert (last5_q <= MAX_LAST5);
+    end
+  end
+`endif
 
 endmodule
 

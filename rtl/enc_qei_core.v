@@ -18,10 +18,10 @@
 // transition it sees.
 // For Fmax, the range's decisions (wrap, stop, hold at CEILING or 0), the zero test and the
 // loads are flag registers, set a clock ahead from the next count's candidates: CEILING acts two
-// clocks after it changes, RANGE and INDEX_CTRL one clock after, a COUNT_LO write loads the count
-// two clocks after its strobe (its value as of the strobe, with the COUNT_HI word staged then),
-// and an index preset loads PRESET as it was one clock earlier. A bus access takes longer than
-// these delays: software cannot tell.
+// clocks after it changes, RANGE and INDEX_CTRL one clock after, a load (a COUNT write) loads the
+// count two clocks after its strobe (its value as of the strobe), and an index preset loads
+// PRESET as it was one clock earlier. A bus access takes longer than these delays: software
+// cannot tell. CTRL.EN gates count steps only: loads and index presets act whatever EN is.
 `default_nettype none
 
 module enc_qei_core #(
@@ -58,14 +58,9 @@ module enc_qei_core #(
     input  wire               probe_edge,     // 0 rising, 1 falling
     input  wire               probe_once,
     input  wire [TS_W-1:0]    timebase,
-    // COUNT_LO / COUNT_HI (external registers)
-    input  wire               count_lo_rd,    // read of COUNT_LO: latch the high word
-    input  wire               count_lo_wr,    // write of COUNT_LO: load the count
-    input  wire [31:0]        count_lo_wdata,
-    input  wire               count_hi_wr,    // write of COUNT_HI: stage the high word
-    input  wire [31:0]        count_hi_wdata,
-    output wire [31:0]        count_lo_rdata,
-    output wire [31:0]        count_hi_rdata,
+    // a COUNT write (the register block assembles the value from its 32-bit words)
+    input  wire               load,           // load the count, two clocks later
+    input  wire [COUNT_W-1:0] load_value,     // ... with this value (taken with the strobe)
     // state
     output wire [COUNT_W-1:0] count,
     output wire [COUNT_W-1:0] idx_latch,
@@ -97,10 +92,7 @@ module enc_qei_core #(
     output wire               cmp_out
 );
 
-  localparam [3:0] F_X4 = 4'd0, F_X2A = 4'd1, F_X2B = 4'd2, F_X1A = 4'd3, F_X1B = 4'd4,
-                   F_PULSE_DIR = 4'd5, F_INCREASE = 4'd6, F_DECREASE = 4'd7, F_X1_HYST = 4'd8;
-  localparam [1:0] R_FREE = 2'd0, R_MODULO = 2'd1, R_LIMIT = 2'd2, R_NON_RECYCLE = 2'd3;
-  localparam [1:0] I_PRESET = 2'd1, I_LATCH = 2'd2;
+  `include "enc_qei_regs.vh"  // the codes of CTRL.FUNC, CTRL.RANGE and INDEX_CTRL.ACTION
 
   function [63:0] zext64;
     input [COUNT_W-1:0] v;
@@ -117,13 +109,16 @@ module enc_qei_core #(
   assign b_eff = b_sw ^ inv_b;
   assign z_eff = z_c ^ inv_z;
 
-  reg  [6:0] cfg_q;  // {func, swap_ab, inv_a, inv_b} last clock
-  wire [6:0] cfg   = {func, swap_ab, inv_a, inv_b};
-  wire       dec_rst = rst | ~valid | (cfg != cfg_q);
+  reg  [7:0] cfg_q;  // {func, swap_ab, inv_a, inv_b, inv_z} last clock
+  wire [7:0] cfg   = {func, swap_ab, inv_a, inv_b, inv_z};
+  wire       dec_rst = rst | ~valid | (cfg[7:1] != cfg_q[7:1]);
+  // a change of SWAP_AB, INV_A, INV_B or INV_Z re-references the index too: the level change it
+  // makes (of Z, or of the gate's A/B state) is not an index edge
+  wire       chan_cfg_change = (cfg[3:0] != cfg_q[3:0]);
 
   always @(posedge clk) begin
     if (rst) begin
-      cfg_q <= 7'd0;
+      cfg_q <= 8'd0;
     end else begin
       cfg_q <= cfg;
     end
@@ -180,40 +175,40 @@ module enc_qei_core #(
     fdn  = 1'b0;
     quad = 1'b1;
     case (func)
-      F_X4: begin
+      ENC_QEI_FUNC_X4: begin
         fup = x4_cnt & x4_up;
         fdn = x4_cnt & ~x4_up;
       end
-      F_X2A: begin
+      ENC_QEI_FUNC_X2A: begin
         fup = x4_cnt & a_moved & x4_up;
         fdn = x4_cnt & a_moved & ~x4_up;
       end
-      F_X2B: begin
+      ENC_QEI_FUNC_X2B: begin
         fup = x4_cnt & b_moved & x4_up;
         fdn = x4_cnt & b_moved & ~x4_up;
       end
-      F_X1A: begin
+      ENC_QEI_FUNC_X1A: begin
         fup = x4_cnt & a_moved & x4_up & a1_q;
         fdn = x4_cnt & a_moved & ~x4_up & ~a1_q;
       end
-      F_X1B: begin
+      ENC_QEI_FUNC_X1B: begin
         fup = x4_cnt & b_moved & x4_up & b1_q;
         fdn = x4_cnt & b_moved & ~x4_up & ~b1_q;
       end
-      F_PULSE_DIR: begin
+      ENC_QEI_FUNC_PULSE_DIR: begin
         fup  = arise_q & b1_q;
         fdn  = arise_q & ~b1_q;
         quad = 1'b0;
       end
-      F_INCREASE: begin
+      ENC_QEI_FUNC_INCREASE: begin
         fup  = arise_q;
         quad = 1'b0;
       end
-      F_DECREASE: begin
+      ENC_QEI_FUNC_DECREASE: begin
         fdn  = arise_q;
         quad = 1'b0;
       end
-      F_X1_HYST: begin
+      ENC_QEI_FUNC_X1_HYST: begin
         fup = h_up;
         fdn = h_dn;
       end
@@ -269,15 +264,13 @@ module enc_qei_core #(
     idx_oneshot_q <= idx_oneshot;
   end
 
-  wire r_free   = (range_q == R_FREE);
-  wire r_nr     = (range_q == R_NON_RECYCLE);
+  wire r_free   = (range_q == ENC_QEI_RANGE_FREE);
+  wire r_nr     = (range_q == ENC_QEI_RANGE_NON_RECYCLE);
 
   // ---- range ---------------------------------------------------------------------------------------
   reg  [COUNT_W-1:0] count_q;
   reg  [COUNT_W-1:0] count_d;
   reg                stopped_q;
-  reg  [31:0]        hi_stage_q;
-  reg  [31:0]        hi_latch_q;
 
   reg  zero_q;  // count_q == 0: a flag register, set from the next count's candidates (Fmax)
   wire at_zero = zero_q;
@@ -362,7 +355,8 @@ module enc_qei_core #(
   reg  idx_prev_q, idx_ok_q, idx_hit1_q, idx_hit_q;
   // a latch hit, registered with the hit (from INDEX_CTRL as the next clock's idx_*_q show it)
   reg  lat_hit_q;  // idx_hit_q & armed & ACTION = latch
-  wire idx_hit1_d = idx_ok_q & (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+  wire idx_hit1_d = idx_ok_q & ~chan_cfg_change &
+                    (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
 
   always @(posedge clk) begin
     if (rst | ~valid) begin
@@ -376,25 +370,21 @@ module enc_qei_core #(
       idx_ok_q   <= 1'b1;
       idx_hit1_q <= idx_hit1_d;
       idx_hit_q  <= idx_hit1_q;  // aligned with the step register above
-      lat_hit_q  <= idx_hit1_q & idx_arm & (idx_action == I_LATCH);
+      lat_hit_q  <= idx_hit1_q & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_LATCH);
     end
   end
 
   wire idx_act = idx_hit_q & armed;
 
   // ---- loads -----------------------------------------------------------------------------------------
-  // verilator lint_off UNUSEDSIGNAL
-  wire [63:0] wr_value = {hi_stage_q, count_lo_wdata};  // (the bits above COUNT_W are dropped)
-  // verilator lint_on UNUSEDSIGNAL
-
-  // COUNT_LO writes and index presets, registered (Fmax): a COUNT_LO write loads the count two
-  // clocks after its strobe (its value taken at the strobe), and an index preset loads PRESET as
-  // it was one clock earlier; the value to load, its comparison with the ceiling and its zero
-  // test are registers.
-  reg               wr_pend_q;    // a COUNT_LO write strobe one clock ago
+  // COUNT writes and index presets, registered (Fmax): a COUNT write loads the count two clocks
+  // after its strobe (its value taken at the strobe), and an index preset loads PRESET as it was
+  // one clock earlier; the value to load, its comparison with the ceiling and its zero test are
+  // registers.
+  reg               wr_pend_q;    // a COUNT write strobe one clock ago
   reg [COUNT_W-1:0] wr_val_q;     // ... its value
-  reg               wr_q;         // a COUNT_LO write to apply this clock
-  reg               load_q;       // a load this clock: a COUNT_LO write or an index preset
+  reg               wr_q;         // a COUNT write to apply this clock
+  reg               load_q;       // a load this clock: a COUNT write or an index preset
   reg [COUNT_W-1:0] load_val_q;   // ... its value (the write first)
   reg               load_ge_q;    // ... >= the next clock's ceiling
   reg               load_zero_q;  // ... == 0
@@ -405,14 +395,14 @@ module enc_qei_core #(
       wr_q      <= 1'b0;
       load_q    <= 1'b0;
     end else begin
-      wr_pend_q <= count_lo_wr;
+      wr_pend_q <= load;
       wr_q      <= wr_pend_q;
-      load_q    <= wr_pend_q | (valid & idx_hit1_q & idx_arm & (idx_action == I_PRESET));
+      load_q    <= wr_pend_q | (valid & idx_hit1_q & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_PRESET));
     end
   end
 
   always @(posedge clk) begin
-    wr_val_q    <= wr_value[COUNT_W-1:0];
+    wr_val_q    <= load_value;
     load_val_q  <= wr_pend_q ? wr_val_q : preset;
     load_ge_q   <= wr_pend_q ? ge_w(wr_val_q, ceiling) : ge_w(preset, ceiling);
     load_zero_q <= wr_pend_q ? (wr_val_q == {COUNT_W{1'b0}}) : (preset == {COUNT_W{1'b0}});
@@ -529,10 +519,10 @@ module enc_qei_core #(
     end
   endfunction
 
-  wire       stop_n  = ~rst & (range == R_NON_RECYCLE) & stopped_d;
-  wire [7:0] sel_mod = sel & {8{range == R_MODULO}};                            // next: modulo
-  wire [7:0] sel_lim = sel & {8{(range == R_LIMIT) | (range == R_NON_RECYCLE)}}; // limit, n_r
-  wire [7:0] sel_bnd = sel & {8{range != R_FREE}};                              // bounded
+  wire       stop_n  = ~rst & (range == ENC_QEI_RANGE_NON_RECYCLE) & stopped_d;
+  wire [7:0] sel_mod = sel & {8{range == ENC_QEI_RANGE_MODULO}};                            // next: modulo
+  wire [7:0] sel_lim = sel & {8{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
+  wire [7:0] sel_bnd = sel & {8{range != ENC_QEI_RANGE_FREE}};                              // bounded
   // (keep: the late candidates' selects are nets, so that each partial flag is one LUT)
   (* keep *) wire [2:0] late_mod;
   assign late_mod = {sel_mod[5], sel_mod[4], sel_mod[2]};
@@ -570,26 +560,6 @@ module enc_qei_core #(
       upd_q     <= ~s_hold;
     end
   end
-
-  // COUNT_HI: the high word latched by a COUNT_LO read; the staged word for a COUNT_LO write.
-  wire [63:0] count64 = zext64(count_q);
-
-  always @(posedge clk) begin
-    if (rst) begin
-      hi_latch_q <= 32'd0;
-      hi_stage_q <= 32'd0;
-    end else begin
-      if (count_lo_rd) begin
-        hi_latch_q <= count64[63:32];
-      end
-      if (count_hi_wr) begin
-        hi_stage_q <= count_hi_wdata;
-      end
-    end
-  end
-
-  assign count_lo_rdata = count64[31:0];
-  assign count_hi_rdata = hi_latch_q;
 
   // ---- direction -----------------------------------------------------------------------------------
   reg dir_q;
@@ -694,7 +664,7 @@ module enc_qei_core #(
   initial load_zero_q = 1'b1;
   // ... the configuration delay and the range / index flags (initial: free range, not stopped,
   // no index hit)
-  initial range_q = R_FREE;
+  initial range_q = ENC_QEI_RANGE_FREE;
   initial idx_arm_q = 1'b0;
   initial idx_action_q = 2'd0;
   initial idx_oneshot_q = 1'b0;
@@ -721,14 +691,14 @@ module enc_qei_core #(
     assert (load_ge_q == (load_val_q >= ceil_nx));
     assert (load_zero_q == (load_val_q == {COUNT_W{1'b0}}));
     assert (step_dn_add_q == step_dn_q);
-    assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == I_PRESET))));
-    assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == I_LATCH)));
+    assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_PRESET))));
+    assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_LATCH)));
     assert (stop_q == (r_nr & stopped_q));
-    assert (up_wrap == ((range_q == R_MODULO) & f_at_ceil));
-    assert (up_lim == (((range_q == R_LIMIT) | r_nr) & f_at_ceil));
+    assert (up_wrap == ((range_q == ENC_QEI_RANGE_MODULO) & f_at_ceil));
+    assert (up_lim == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & f_at_ceil));
     assert (up_blk == (stop_q | (~r_free & f_at_ceil)));
-    assert (dn_wrap_q == ((range_q == R_MODULO) & zero_q));
-    assert (dn_lim_q == (((range_q == R_LIMIT) | r_nr) & zero_q));
+    assert (dn_wrap_q == ((range_q == ENC_QEI_RANGE_MODULO) & zero_q));
+    assert (dn_lim_q == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & zero_q));
     assert (dn_blk_q == (stop_q | (~r_free & zero_q)));
   end
 `endif

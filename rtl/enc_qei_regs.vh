@@ -135,22 +135,32 @@ localparam [3:0] ENC_QEI_FUNC_PULSE_DIR = 4'd5;
 localparam [3:0] ENC_QEI_FUNC_INCREASE = 4'd6;
 localparam [3:0] ENC_QEI_FUNC_DECREASE = 4'd7;
 localparam [3:0] ENC_QEI_FUNC_X1_HYST = 4'd8;
+localparam integer ENC_QEI_FUNC_N = 9;
 localparam [1:0] ENC_QEI_RANGE_FREE = 2'd0;
 localparam [1:0] ENC_QEI_RANGE_MODULO = 2'd1;
 localparam [1:0] ENC_QEI_RANGE_LIMIT = 2'd2;
 localparam [1:0] ENC_QEI_RANGE_NON_RECYCLE = 2'd3;
+localparam integer ENC_QEI_RANGE_N = 4;
 localparam [1:0] ENC_QEI_INDEX_ACTION_NONE = 2'd0;
 localparam [1:0] ENC_QEI_INDEX_ACTION_PRESET = 2'd1;
 localparam [1:0] ENC_QEI_INDEX_ACTION_LATCH = 2'd2;
+localparam integer ENC_QEI_INDEX_ACTION_N = 3;
 localparam [0:0] ENC_QEI_Z_EDGE_RISING = 1'd0;
 localparam [0:0] ENC_QEI_Z_EDGE_FALLING = 1'd1;
+localparam integer ENC_QEI_Z_EDGE_N = 2;
 localparam [0:0] ENC_QEI_PROBE_EDGE_RISING = 1'd0;
 localparam [0:0] ENC_QEI_PROBE_EDGE_FALLING = 1'd1;
+localparam integer ENC_QEI_PROBE_EDGE_N = 2;
 localparam [0:0] ENC_QEI_EDGE_TYPE_ANY = 1'd0;
 localparam [0:0] ENC_QEI_EDGE_TYPE_A_RISING = 1'd1;
+localparam integer ENC_QEI_EDGE_TYPE_N = 2;
+
+// Bundle widths of the register block (rtl/enc_qei_regs.v, enc_qei_regs_fields.vh)
+localparam integer ENC_QEI_R2H_W = 402, ENC_QEI_H2R_W = 525;
 // verilator lint_on UNUSEDPARAM
 
-// 1: the byte address is a register of the map
+// 1: the byte address is a register of the map (bits 1:0 ignored)
+// verilator lint_off UNUSEDSIGNAL
 function enc_qei_mapped;
   input [7:0] addr;
   begin
@@ -160,3 +170,4 @@ function enc_qei_mapped;
     endcase
   end
 endfunction
+// verilator lint_on UNUSEDSIGNAL

@@ -584,7 +584,7 @@ async def reset_mid_motion(dut):
     env.pos = wf.positions[-1]
     await env.settle(20)
     for name, reg in regmap().items():
-        if reg.external or name in ("TIMEBASE", "STATUS", "EVENTS", "GLITCH_COUNT", "QERR_COUNT"):
+        if reg.coherent or name in ("TIMEBASE", "STATUS", "EVENTS", "GLITCH_COUNT", "QERR_COUNT"):
             continue
         exp = sum((f.reset or 0) << f.lsb for f in reg.fields.values() if f.kind != "in" or
                   f.reset is not None) if name not in ("CAPS",) else None
@@ -631,7 +631,7 @@ async def register_walk(dut):
     for r in regs:
         kinds = {f.kind for f in r.fields.values()}
         before = await bus.rd(r.name)
-        if r.external:  # COUNT_LO / COUNT_HI: loads the count (checked as a pair below)
+        if r.coherent:  # COUNT_LO / COUNT_HI: loads the count (checked as a pair below)
             continue
         if kinds <= {"const", "in"}:
             await bus.wr(r.name, ~before & 0xFFFFFFFF)

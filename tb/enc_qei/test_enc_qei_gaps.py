@@ -856,7 +856,7 @@ async def one_clock_reset_in_motion(dut):
 def _cfg_regs():
     """Registers with a storage (cfg) field and no write side effect the walk would disturb."""
     return [r for r in sorted(regmap().values(), key=lambda r: r.offset)
-            if not r.external and r.name != "EVENTS" and any(f.kind == "cfg" for f in r.fields.values())]
+            if not r.coherent and r.name != "EVENTS" and any(f.kind == "cfg" for f in r.fields.values())]
 
 
 def _cfg_mask(r, count_w, ts_w):

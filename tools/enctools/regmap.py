@@ -29,12 +29,12 @@ def compile_rdl(path: Path = RDL):
 def field_kind(f) -> str:
     """What the register block makes of a field (rtl/enc_qei_regs.v's generator): const, in
     (live from the hardware), cfg (storage), pulse (write-1 single pulse), intr (event, write 1 to
-    clear), counter (saturating, a write clears) or ext (an external register's field)."""
+    clear), counter (saturating, a write clears) or coherent (a half of the count)."""
     sw, hw = f.get_property("sw").name, f.get_property("hw").name
     onwrite = f.get_property("onwrite")
     ow = onwrite.name if onwrite is not None else None
-    if f.parent.external:
-        return "ext"
+    if f.get_property("coherent"):
+        return "coherent"
     if f.get_property("intr") and ow == "woclr" and sw == "rw":
         return "intr"
     if f.get_property("counter") and f.get_property("incrsaturate") and ow == "wclr" and sw == "rw":
@@ -72,9 +72,13 @@ class Field:
 class Reg:
     name: str
     offset: int
-    external: bool
     feature: str | None
     fields: dict  # name -> Field, in bit order
+
+    @property
+    def coherent(self) -> bool:
+        """COUNT_LO / COUNT_HI: the count's halves (a read latches, a write stages or loads)."""
+        return any(f.kind == "coherent" for f in self.fields.values())
 
 
 @lru_cache(maxsize=None)
@@ -89,8 +93,7 @@ def regmap() -> dict[str, Reg]:
                 f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
                 f.get_property("reset"), f.get_property("sized_by"),
                 {m.name: m.value for m in enc} if enc is not None else None, field_kind(f))
-        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.external,
-                                r.get_property("feature"), fields)
+        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.get_property("feature"), fields)
     return regs
 
 

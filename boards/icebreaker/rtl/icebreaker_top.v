@@ -123,23 +123,14 @@ module icebreaker_top #(
   end
 
   // ---- QEI peripheral: the 4X position and the events ------------------------------------------
-  // enc_qei registers: byte offsets and bit positions from rtl/enc_qei.rdl (doc/enc_qei_regs.md);
-  // the board test checks every access against the compiled RDL.
-  localparam [7:0] QEI_CTRL = 8'h08;
-  localparam [7:0] QEI_COUNT_LO = 8'h10;
-  localparam [7:0] QEI_EVENTS = 8'h4C;
-  localparam integer CTRL_EN = 0;  // CTRL.EN
-  localparam integer CTRL_FUNC = 8;  // CTRL.FUNC, 4 bits: 0 = x4
-  localparam integer CTRL_RANGE = 12;  // CTRL.RANGE, 2 bits: 0 = free (wraps modulo 2^COUNT_W)
-  localparam integer CTRL_FILTER_LEN = 16;  // CTRL.FILTER_LEN, 5 bits
-  localparam integer EV_INDEX = 2;  // EVENTS.INDEX
-  localparam integer EV_QERR = 5;  // EVENTS.QERR
-  localparam integer EV_GLITCH = 6;  // EVENTS.GLITCH
-  localparam [31:0] FUNC_X4 = 32'd0;
-  localparam [31:0] RANGE_FREE = 32'd0;
+  // enc_qei registers: offsets, field positions and codes from the map (rtl/enc_qei_regs.vh,
+  // generated from rtl/enc_qei.rdl)
+  `include "enc_qei_regs.vh"
   localparam [31:0] FILTER_LEN32 = FILTER_LEN;
-  localparam [31:0] CTRL_WORD = (32'd1 << CTRL_EN) | (FUNC_X4 << CTRL_FUNC) |
-                                (RANGE_FREE << CTRL_RANGE) | (FILTER_LEN32 << CTRL_FILTER_LEN);
+  localparam [31:0] CTRL_WORD = (32'd1 << ENC_QEI_CTRL_EN) |
+                                ({28'd0, ENC_QEI_FUNC_X4} << ENC_QEI_CTRL_FUNC) |
+                                ({30'd0, ENC_QEI_RANGE_FREE} << ENC_QEI_CTRL_RANGE) |
+                                (FILTER_LEN32 << ENC_QEI_CTRL_FILTER_LEN);
 
   wire        wb_stb, wb_we, wb_ack, wb_err;
   reg  [ 7:0] wb_adr;
@@ -287,11 +278,11 @@ module icebreaker_top #(
     m_d     = m_q;
     cnt_d   = cnt_q;
     ev_d    = ev_q;
-    wb_adr  = QEI_EVENTS;
+    wb_adr  = ENC_QEI_EVENTS;
     wb_wdat = 32'd0;
     case (m_q)
       M_CTRL: begin
-        wb_adr  = QEI_CTRL;
+        wb_adr  = ENC_QEI_CTRL;
         wb_wdat = CTRL_WORD;
         if (wb_end) m_d = M_IDLE;
       end
@@ -299,7 +290,7 @@ module icebreaker_top #(
         if (st_q == S_BUS) m_d = M_CNT;
       end
       M_CNT: begin
-        wb_adr = QEI_COUNT_LO;
+        wb_adr = ENC_QEI_COUNT_LO;
         if (wb_end) begin
           cnt_d = wb_rdat[POS_WIDTH-1:0];
           m_d   = M_EVR;
@@ -307,14 +298,14 @@ module icebreaker_top #(
       end
       M_EVR: begin
         if (wb_end) begin
-          ev_d = {wb_rdat[EV_INDEX], wb_rdat[EV_GLITCH], wb_rdat[EV_QERR]};
+          ev_d = {wb_rdat[ENC_QEI_EVENTS_INDEX], wb_rdat[ENC_QEI_EVENTS_GLITCH], wb_rdat[ENC_QEI_EVENTS_QERR]};
           m_d  = M_EVW;
         end
       end
       default: begin  // M_EVW: write 1 to clear what was read
-        wb_wdat[EV_INDEX]  = ev_q[2];
-        wb_wdat[EV_GLITCH] = ev_q[1];
-        wb_wdat[EV_QERR]   = ev_q[0];
+        wb_wdat[ENC_QEI_EVENTS_INDEX]  = ev_q[2];
+        wb_wdat[ENC_QEI_EVENTS_GLITCH] = ev_q[1];
+        wb_wdat[ENC_QEI_EVENTS_QERR]   = ev_q[0];
         if (wb_end) m_d = M_IDLE;
       end
     endcase

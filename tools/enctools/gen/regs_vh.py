@@ -5,13 +5,16 @@ Verilog reader of the map (the core, the top, the formal wrappers, the board):
   ENC_QEI_<REG>            byte offset of a register
   ENC_QEI_<REG>_<FIELD>    the field's lsb, and ..._W its width
   ENC_QEI_<ENUM>_<MEMBER>  an enum member's code, sized to its field (ENUM = the RDL enum type
-                           without _e: FUNC, RANGE, INDEX_ACTION, Z_EDGE, PROBE_EDGE, EDGE_TYPE)
+                           without _e: FUNC, RANGE, INDEX_ACTION, Z_EDGE, PROBE_EDGE, EDGE_TYPE);
+                           ENC_QEI_<ENUM>_N the number of members
+  ENC_QEI_R2H_W, _H2R_W    the widths of the register block's bundles (enc_qei_regs_fields.vh)
   enc_qei_mapped(addr)     1 for a byte address that is a register (bits 1:0 ignored)
 """
 
 from __future__ import annotations
 
 from . import HEADER_V
+from .bundle import build
 
 
 def enum_types(top) -> dict[str, tuple[int, list]]:
@@ -47,11 +50,17 @@ def render(top) -> str:
         for m in members:
             lines.append(f"localparam [{width - 1}:0] ENC_QEI_{name}_{m.name.upper()} = "
                          f"{width}'d{m.value};")
+        lines.append(f"localparam integer ENC_QEI_{name}_N = {len(members)};")
+    b = build(top)
+    lines += ["", "// Bundle widths of the register block (rtl/enc_qei_regs.v, enc_qei_regs_fields.vh)",
+              f"localparam integer ENC_QEI_R2H_W = {b.r2h_w}, ENC_QEI_H2R_W = {b.h2r_w};"]
     idx = sorted(r.address_offset >> 2 for r in regs)
     lines += ["// verilator lint_on UNUSEDPARAM", "",
-              "// 1: the byte address is a register of the map",
+              "// 1: the byte address is a register of the map (bits 1:0 ignored)",
+              "// verilator lint_off UNUSEDSIGNAL",
               "function enc_qei_mapped;", "  input [7:0] addr;", "  begin",
               "    case (addr[7:2])",
               "      " + ", ".join(f"6'd{i}" for i in idx) + ": enc_qei_mapped = 1'b1;",
-              "      default: enc_qei_mapped = 1'b0;", "    endcase", "  end", "endfunction", ""]
+              "      default: enc_qei_mapped = 1'b0;", "    endcase", "  end", "endfunction",
+              "// verilator lint_on UNUSEDSIGNAL", ""]
     return "\n".join(lines)

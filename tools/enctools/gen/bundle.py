@@ -1,0 +1,142 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The register block's two bundles, from the compiled RDL: ``reg2hw`` (what the registers give
+the hardware: configuration, pulses, pending events, the count to load) and ``hw2reg`` (what the
+hardware gives the registers: live values, event and counter strobes, hardware clears, the
+count). OpenTitan's reg2hw / hw2reg structures, as Verilog-2005 vectors with fixed positions.
+
+One entry per field, named ``<reg>_<field>`` in lower case (``ctrl_func``), with these merges:
+- a register whose only field is VALUE gives ``<reg>`` (``snap_period``);
+- a pair X_LO / X_HI of COUNT_W-sized values (``sized_by`` COUNT_W:0 and COUNT_W:1) gives one
+  64-bit entry ``x`` (``preset``: bits 31:0 from X_LO, 63:32 from X_HI);
+- the event register (``intr`` fields) gives ``<reg>`` (pending bits) and ``<reg>_set`` (set
+  strobes), each as wide as the register's top event bit, bits at their register positions;
+- the coherent pair COUNT_LO / COUNT_HI (``coherent`` "lo" / "hi") gives ``count`` (hw2reg, the
+  live count) and ``count_load`` / ``count_load_value`` (reg2hw).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..regmap import field_kind
+
+
+@dataclass
+class Entry:
+    name: str
+    width: int
+    desc: str
+    lsb: int = 0
+
+    @property
+    def rng(self) -> str:
+        """The entry's bits in its bundle, as a Verilog range."""
+        return f"[{self.lsb + self.width - 1}:{self.lsb}]" if self.width > 1 else f"[{self.lsb}]"
+
+
+@dataclass
+class Bundles:
+    r2h: list = field(default_factory=list)
+    h2r: list = field(default_factory=list)
+    # (register, field) -> (side, entry, lsb inside the entry): where a field's value lives
+    where: dict = field(default_factory=dict)
+
+    @property
+    def r2h_w(self) -> int:
+        return sum(e.width for e in self.r2h)
+
+    @property
+    def h2r_w(self) -> int:
+        return sum(e.width for e in self.h2r)
+
+    def add(self, side: str, name: str, width: int, desc: str) -> Entry:
+        lst = self.r2h if side == "r2h" else self.h2r
+        found = next((e for e in lst if e.name == name), None)
+        if found:
+            return found
+        e = Entry(name, width, desc, sum(x.width for x in lst))
+        lst.append(e)
+        return e
+
+
+def pair_base(reg) -> tuple[str, int] | None:
+    """(base name, half) of a register of an X_LO / X_HI pair of COUNT_W-sized values."""
+    fields = list(reg.fields())
+    if len(fields) != 1 or fields[0].inst_name != "VALUE":
+        return None
+    sz = fields[0].get_property("sized_by")
+    name = reg.inst_name
+    if sz == "COUNT_W:0" and name.endswith("_LO"):
+        return name[:-3].lower(), 0
+    if sz == "COUNT_W:1" and name.endswith("_HI"):
+        return name[:-3].lower(), 1
+    return None
+
+
+def entry_name(reg, f) -> str:
+    fields = list(reg.fields())
+    if len(fields) == 1 and f.inst_name == "VALUE":
+        return reg.inst_name.lower()
+    return f"{reg.inst_name}_{f.inst_name}".lower()
+
+
+def build(top) -> Bundles:
+    b = Bundles()
+    for reg in top.registers():
+        rn = reg.inst_name
+        intr_top = max((f.msb for f in reg.fields() if field_kind(f) == "intr"), default=-1)
+        for f in reg.fields():
+            kind, desc = field_kind(f), f"{rn}.{f.inst_name}"
+            coherent = f.get_property("coherent")
+            pair = pair_base(reg)
+            if kind == "coherent":
+                e = b.add("h2r", "count", 64, "the live count (COUNT_W bits, zero-extended)")
+                b.where[(rn, f.inst_name)] = ("h2r", e, 32 if coherent == "hi" else 0)
+                if coherent == "lo":
+                    b.add("r2h", "count_load", 1, "load the count: a COUNT_LO write")
+                    b.add("r2h", "count_load_value", 64,
+                          "the value to load: {word staged by COUNT_HI, COUNT_LO word}")
+                continue
+            if kind == "const":
+                continue
+            if kind == "intr":
+                e = b.add("r2h", rn.lower(), intr_top + 1, f"{rn}: pending bits")
+                b.add("h2r", f"{rn.lower()}_set", intr_top + 1, f"{rn}: set strobes")
+                b.where[(rn, f.inst_name)] = ("r2h", e, f.lsb)
+                continue
+            if kind == "counter":
+                b.add("h2r", f"{entry_name(reg, f)}_incr", 1, f"{desc}: count one")
+                continue
+            side = "h2r" if kind == "in" else "r2h"
+            if pair:
+                e = b.add(side, pair[0], 64, f"{pair[0].upper()}_LO / _HI (COUNT_W bits)")
+                b.where[(rn, f.inst_name)] = (side, e, 32 * pair[1])
+            else:
+                e = b.add(side, entry_name(reg, f), f.width, desc)
+                b.where[(rn, f.inst_name)] = (side, e, 0)
+            if kind == "cfg" and f.get_property("hwclr"):
+                b.add("h2r", f"{entry_name(reg, f)}_clr", 1, f"{desc}: hardware clear")
+    return b
+
+
+def render_fields(top) -> str:
+    """rtl/enc_qei_regs_fields.vh: named wires over the bundles, for the module that connects the
+    register block (it declares `reg2hw` and `hw2reg` first): r2h_<entry> to read, h2r_<entry>
+    to drive."""
+    from . import HEADER_V
+
+    b = build(top)
+    lines = [*HEADER_V, "// The fields of the register block's bundles by name (rtl/enc_qei_regs.v). Include it",
+             "// inside the module that instantiates the block, after declaring",
+             "//   wire [ENC_QEI_R2H_W-1:0] reg2hw;  wire [ENC_QEI_H2R_W-1:0] hw2reg;",
+             "// then read r2h_<name> and drive every h2r_<name>.",
+             "// verilator lint_off UNUSEDSIGNAL"]
+    for e in b.r2h:
+        rng = f"[{e.width - 1}:0] " if e.width > 1 else ""
+        lines.append(f"wire {rng}r2h_{e.name} = reg2hw{e.rng};  // {e.desc}")
+    lines.append("// verilator lint_on UNUSEDSIGNAL")
+    for e in b.h2r:
+        rng = f"[{e.width - 1}:0] " if e.width > 1 else ""
+        lines.append(f"wire {rng}h2r_{e.name};  // {e.desc}")
+    lines.append("assign hw2reg = {" + ", ".join(f"h2r_{e.name}" for e in reversed(b.h2r)) + "};")
+    return "\n".join(lines) + "\n"
