@@ -25,10 +25,10 @@
 //     (one request at a time) is asserted in the stand-in;
 //   - the adapter's busy_q (probe) is high exactly while its request is in enc_qei (the
 //     induction needs it: while the bus is idle no port shows it).
-// ABORT = 1 (not a task of formal/enc_qei_wb.sby: the adapter fails it, see formal/README.md):
-// a master that may abandon a request by dropping cyc; then the answer may come up to four
-// clocks after the request (the adapter first waits for the abandoned one) and the request
-// need not reach enc_qei in its first clock, everything else as above.
+// ABORT = 1 (task prove_abort): a master that may abandon a request by dropping cyc; then the
+// answer may come up to four clocks after the request (the adapter first waits for the abandoned
+// one, which it carries out but does not answer) and the request need not reach enc_qei in its
+// first clock, everything else as above.
 `default_nettype none
 
 module enc_qei_wb_formal #(
@@ -79,6 +79,7 @@ module enc_qei_wb_formal #(
   // Probes, connected by the .sby after flatten: the adapter's enc_qei port (dut.u_qei.req_*)
   // and its one state register (dut.busy_q).
   (* keep *) wire        p_busy_q;
+  (* keep *) wire        p_held_q;
   (* keep *) wire        p_req_valid;
   (* keep *) wire        p_req_write;
   (* keep *) wire [7:0]  p_req_addr;
@@ -134,6 +135,10 @@ module enc_qei_wb_formal #(
     if (f_past_valid && !rst) begin
       // the adapter is busy exactly while its request is in enc_qei (the induction invariant)
       assert (p_busy_q == (f_q1 || f_q2));
+      // held_q: the request in enc_qei is still wanted (always, unless the master aborts)
+      assert (!p_held_q || p_busy_q);
+      if (!ABORT) assert (p_held_q == p_busy_q);
+      if (p_held_q && wb_cyc_i) assert (f_busy);
     end
     if (f_past_valid && !rst) begin
       // err exactly for an unmapped offset

@@ -5,6 +5,8 @@
 // response two clocks later is the acknowledge -- wb_ack_o, or wb_err_o for an unmapped offset
 // (which reads 0 and writes nothing). So every access takes three clocks and always completes.
 // No new request starts until that response (the master still holds its strobe in its clock).
+// A master that abandons a request (drops cyc before the answer) gets no answer for it; its
+// next request is answered after the abandoned one has completed (at most four clocks).
 // wb_sel_i are the byte enables of a write. All the peripheral's behaviour is in enc_qei.
 `default_nettype none
 `include "enc_params.vh"
@@ -46,15 +48,23 @@ module enc_qei_wb #(
 
   wire resp_valid, resp_err;
   reg  busy_q;  // a request is in enc_qei: from the clock after it until its response
+  reg  held_q;  // ... and cyc has stayed high since: the master still waits for its answer
   wire req_valid = wb_cyc_i & wb_stb_i & ~busy_q;
 
   always @(posedge clk) begin
     if (rst) begin
       busy_q <= 1'b0;
+      held_q <= 1'b0;
     end else if (req_valid) begin
       busy_q <= 1'b1;
-    end else if (resp_valid) begin
-      busy_q <= 1'b0;
+      held_q <= 1'b1;
+    end else begin
+      if (resp_valid) begin
+        busy_q <= 1'b0;
+      end
+      if (resp_valid | ~wb_cyc_i) begin
+        held_q <= 1'b0;
+      end
     end
   end
 
@@ -83,8 +93,10 @@ module enc_qei_wb #(
       .cmp_out   (cmp_out)
   );
 
-  assign wb_ack_o = wb_cyc_i & resp_valid & ~resp_err;
-  assign wb_err_o = wb_cyc_i & resp_valid & resp_err;
+  // A request the master abandoned (cyc dropped before its answer) is still carried out, but its
+  // answer is not given: the next request waits for it and is answered itself.
+  assign wb_ack_o = wb_cyc_i & held_q & resp_valid & ~resp_err;
+  assign wb_err_o = wb_cyc_i & held_q & resp_valid & resp_err;
 
 endmodule
 
