@@ -7,8 +7,8 @@
 
 Signals are named by their last path component (or any suffix of the dotted path, e.g.
 ``demo_top.a_in``). One-bit signals are drawn as logic traces, wider ones as buses with their
-values written in (decimal; ``--hex NAME`` for BCD or hex). ``scripts/demo.py`` calls
-:func:`demo_figure` to make the README picture from the demo's own dump.
+values written in (decimal; ``--hex NAME`` for BCD or hex). The demo (enctools.demo.view) renders
+its README picture from its own dump with :func:`render`.
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+from .qei.bus import signed
 
 TIMESCALE_UNITS = {"s": 1e12, "ms": 1e9, "us": 1e6, "ns": 1e3, "ps": 1.0, "fs": 1e-3}
 
@@ -110,9 +112,7 @@ def _fmt(bits: str, width: int, style: str) -> str:
     n = int(bits, 2)
     if style == "hex":
         return f"{n:0{(width + 3) // 4}x}"
-    if style == "signed" and n >= 1 << (width - 1):
-        n -= 1 << width
-    return str(n)
+    return str(signed(n, width) if style == "signed" else n)
 
 
 def draw(ax_rows, found, rows, t0_ps: float, t1_ps: float, unit_ps: float = 1e6):
@@ -188,24 +188,6 @@ def render(vcd, png, windows, rows=DEMO_ROWS, title=None):
     Path(png).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(png, dpi=110)
     plt.close(fig)
-
-
-def demo_figure(vcd, png, plan) -> None:
-    """The README picture: three cycles at constant peak speed, and two periods of the dither."""
-    tau_ps = 1e12 / (plan.opts.rpm / 60.0 * 500)
-    base = plan.t0_ps  # simulation time (ps) at which the model waveform starts
-    h0, h1 = plan.seg["hold"]
-    a = base + (h0 + h1) / 2 * 1000
-    d0, _ = plan.seg["dither"]
-    b = base + d0 * 1000
-    windows = [(a, a + 3 * tau_ps, f"{plan.opts.rpm:g} rpm forward, 3 cycles: 1X pulses once per cycle,\n"
-                                     "2X twice (each edge of A), 4X four times"),
-               (b, b + 2.2 * 5 * tau_ps, "shaft dithering about one edge of A: 4X and 2X count every "
-                                          "crossing,\nup and down (net 0); the 1X hysteresis counter "
-                                          "counts once")]
-    render(vcd, png, windows,
-           title=f"make demo: modeled HEDS-5000 ({plan.opts.rpm:g} rpm, {plan.opts.temp_c:g} degC), "
-                 f"clock {plan.clk_hz / 1e6:.4g} MHz - from sim/waves/demo.vcd")
 
 
 def main(argv=None) -> int:
