@@ -77,11 +77,20 @@ class Reg:
     fields: dict  # name -> Field, in bit order
 
 
+def _feature(reg) -> str | None:
+    """A register's ``feature`` property; None in an RDL that does not define the property."""
+    try:
+        return reg.get_property("feature")
+    except LookupError:
+        return None
+
+
 @lru_cache(maxsize=None)
-def regmap() -> dict[str, Reg]:
-    """Registers by name, in address order."""
+def regmap(path: Path = RDL) -> dict[str, Reg]:
+    """Registers by name, in address order (``path``: another RDL than rtl/enc_qei.rdl, e.g. the
+    one of a git revision a bench simulates)."""
     regs = {}
-    for r in compile_rdl().registers():
+    for r in compile_rdl(path).registers():
         fields = {}
         for f in r.fields():
             enc = f.get_property("encode")
@@ -89,8 +98,7 @@ def regmap() -> dict[str, Reg]:
                 f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
                 f.get_property("reset"), f.get_property("sized_by"),
                 {m.name: m.value for m in enc} if enc is not None else None, field_kind(f))
-        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.external,
-                                r.get_property("feature"), fields)
+        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.external, _feature(r), fields)
     return regs
 
 
