@@ -29,71 +29,78 @@ class Var:
         self.changes: list[tuple[float, str]] = []   # (time ps, value as a bit string)
 
 
-def read_vcd(path, wanted, t_end_ps: float | None = None):
-    """Read the signals named in ``wanted`` (suffixes of their dotted paths) from a VCD, up to
-    ``t_end_ps``. Returns ({wanted name: Var}, timescale in ps). Value strings are bits
-    ('0', '1', 'x', 'z', or a vector without the 'b')."""
+def _timescale_ps(spec: str) -> float:
+    num = "".join(c for c in spec if c.isdigit()) or "1"
+    unit = spec[len(num):] if spec.startswith(num) else spec.lstrip("0123456789")
+    return float(num) * TIMESCALE_UNITS.get(unit, 1.0)
+
+
+def _read_header(f, wanted):
+    """The definitions up to $enddefinitions: ({wanted name: Var}, {id code: [Var]}, timescale
+    in ps)."""
+    buf = []
+    for line in f:
+        buf.append(line)
+        if "$enddefinitions" in line:
+            break
+    header = " ".join(buf).split()
     scope: list[str] = []
     by_code: dict[str, list[Var]] = {}
     found: dict[str, Var] = {}
     ts_ps = 1.0
-    with open(path, "r", errors="replace") as f:
-        # ---- header
-        buf = []
-        for line in f:
-            buf.append(line)
-            if "$enddefinitions" in line:
+    i = 0
+    while i < len(header):
+        tok = header[i]
+        if tok == "$timescale":
+            j = header.index("$end", i)
+            ts_ps = _timescale_ps("".join(header[i + 1:j]))
+            i = j
+        elif tok == "$scope":
+            scope.append(header[i + 2])
+            i += 3
+        elif tok == "$upscope":
+            scope.pop()
+        elif tok == "$var":
+            j = header.index("$end", i)
+            width, code, name = int(header[i + 2]), header[i + 3], header[i + 4]
+            full = ".".join(scope + [name])
+            for w in wanted:
+                if w not in found and (full == w or full.endswith("." + w)):
+                    var = Var(full, width)
+                    found[w] = var
+                    by_code.setdefault(code, []).append(var)
+            i = j
+        i += 1
+    return found, by_code, ts_ps
+
+
+def _read_changes(f, by_code, ts_ps: float, t_end_ps: float | None) -> None:
+    """The value changes of the signals in ``by_code``, up to ``t_end_ps``."""
+    t = 0.0
+    for line in f:
+        if not line or line[0] == "$":
+            continue
+        c = line[0]
+        if c == "#":
+            t = float(line[1:]) * ts_ps
+            if t_end_ps is not None and t > t_end_ps:
                 break
-        header = " ".join(buf).split()
-        i = 0
-        while i < len(header):
-            tok = header[i]
-            if tok == "$timescale":
-                j = header.index("$end", i)
-                spec = "".join(header[i + 1:j])
-                num = "".join(c for c in spec if c.isdigit()) or "1"
-                unit = spec[len(num):] if spec.startswith(num) else spec.lstrip("0123456789")
-                ts_ps = float(num) * TIMESCALE_UNITS.get(unit, 1.0)
-                i = j
-            elif tok == "$scope":
-                scope.append(header[i + 2])
-                i += 3
-            elif tok == "$upscope":
-                scope.pop()
-            elif tok == "$var":
-                j = header.index("$end", i)
-                width, code, name = int(header[i + 2]), header[i + 3], header[i + 4]
-                full = ".".join(scope + [name])
-                for w in wanted:
-                    if w in found:
-                        continue
-                    if full == w or full.endswith("." + w):
-                        var = Var(full, width)
-                        found[w] = var
-                        by_code.setdefault(code, []).append(var)
-                i = j
-            i += 1
-        # ---- value changes
-        t = 0.0
-        for line in f:
-            if not line or line[0] == "$":
-                continue
-            c = line[0]
-            if c == "#":
-                t = float(line[1:]) * ts_ps
-                if t_end_ps is not None and t > t_end_ps:
-                    break
-            elif c in "01xzXZ":
-                vs = by_code.get(line[1:].strip())
-                if vs:
-                    for v in vs:
-                        v.changes.append((t, c.lower()))
-            elif c in "bBrR":
-                val, _, code = line[1:].strip().partition(" ")
-                vs = by_code.get(code)
-                if vs:
-                    for v in vs:
-                        v.changes.append((t, val.lower()))
+        elif c in "01xzXZ":
+            for v in by_code.get(line[1:].strip(), ()):
+                v.changes.append((t, c.lower()))
+        elif c in "bBrR":
+            val, _, code = line[1:].strip().partition(" ")
+            for v in by_code.get(code, ()):
+                v.changes.append((t, val.lower()))
+
+
+def read_vcd(path, wanted, t_end_ps: float | None = None):
+    """Read the signals named in ``wanted`` (suffixes of their dotted paths) from a VCD, up to
+    ``t_end_ps``. Returns ({wanted name: Var}, timescale in ps). Value strings are bits
+    ('0', '1', 'x', 'z', or a vector without the 'b')."""
+    with open(path, "r", errors="replace") as f:
+        found, by_code, ts_ps = _read_header(f, wanted)
+        _read_changes(f, by_code, ts_ps, t_end_ps)
     return found, ts_ps
 
 
