@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """`make demo`: a modeled HEDS-5000 on a motor driving every circuit of the library at once.
 
-The command line of enctools.demo (tools/enctools/demo.py); --help lists its options."""
+The command line of enctools.demo (tools/enctools/demo/cli.py); --help lists its options."""
 
 import sys
 

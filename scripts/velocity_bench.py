@@ -2,11 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Velocity-method accuracy on modelled HEDS-5000 units (`make velocity`).
 
-The command line of enctools.velocity_bench (tools/enctools/velocity_bench.py); --help lists its options."""
+The command line of enctools.velocity (tools/enctools/velocity/cli.py); --help lists its options."""
 
 import sys
 
-from enctools.velocity_bench import main
+from enctools.velocity import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """`make demo` (scripts/demo.py): its options are checked before anything is built, and a short
 run of the whole demo (every circuit from one modeled HEDS-5000) passes and leaves a VCD that
-scripts/vcd_to_png.py reads.
+enctools.vcd_png reads.
 """
 
 from __future__ import annotations
@@ -9,13 +9,13 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from pathlib import Path
 
-from enctools import toolenv
 import pytest
 
-TOP = Path(__file__).resolve().parents[2]
-from enctools import demo
+from enctools import toolenv
+from enctools import vcd_png
+from enctools.demo import config, options
+from enctools.paths import TOP
 
 
 @pytest.mark.parametrize("kwargs, fragment", [
@@ -39,20 +39,20 @@ from enctools import demo
     ({"seed": "x"}, "is not a number"),
 ])
 def test_bad_option_rejected(kwargs, fragment):
-    with pytest.raises(demo.OptionError, match=fragment) as exc:
-        demo.validate(**kwargs)
+    with pytest.raises(options.OptionError, match=fragment) as exc:
+        options.validate(**kwargs)
     assert "\n" not in str(exc.value)
 
 
 def test_defaults_and_good_values():
-    assert demo.validate() == demo.Options(3000.0, 25.0, 12e6, 1)
-    assert demo.validate("", "", "", "") == demo.Options(3000.0, 25.0, 12e6, 1)
-    o = demo.validate(rpm="8000", temp_c="-40", clk_hz="48e6", seed="7")
+    assert options.validate() == options.Options(3000.0, 25.0, 12e6, 1)
+    assert options.validate("", "", "", "") == options.Options(3000.0, 25.0, 12e6, 1)
+    o = options.validate(rpm="8000", temp_c="-40", clk_hz="48e6", seed="7")
     assert (o.rpm, o.temp_c, o.clk_hz, o.seed) == (8000.0, -40.0, 48e6, 7)
-    assert demo.validate(rpm="600").rpm == 600.0      # the note's 600 rpm example
+    assert options.validate(rpm="600").rpm == 600.0      # the note's 600 rpm example
     # the decoder limit follows the clock: the same speed that fails at 300 kHz passes at 12 MHz
-    assert demo.validate(rpm="3000", clk_hz="12e6").rpm == 3000.0
-    assert 58_000 < demo.rpm_of(demo.f_max_hz(12e6, 25.0)) < 58_500
+    assert options.validate(rpm="3000", clk_hz="12e6").rpm == 3000.0
+    assert 58_000 < options.rpm_of(options.f_max_hz(12e6, 25.0)) < 58_500
 
 
 def test_bad_option_fails_before_building():
@@ -66,8 +66,6 @@ def test_bad_option_fails_before_building():
 
 def test_short_demo_run(tmp_path):
     """The whole demo at 20000 rpm (few clocks, Icarus): every verdict passes, the VCD parses."""
-    from enctools import vcd_png as vcd_to_png
-
     env = dict(os.environ, PATH=toolenv.tool_path())
     png = tmp_path / "waves.png"
     r = subprocess.run([sys.executable, str(TOP / "scripts" / "demo.py"), "--rpm", "20000",
@@ -88,11 +86,11 @@ def test_short_demo_run(tmp_path):
     assert hold and all(row[-4] == "ok" for row in hold), vel
     for row in hold:   # at 20000 rpm, M/T A-rise within the tolerance of the true speed
         true, mt = float(row[2]), float(row[3])
-        assert true == 20000.0 and abs(mt - true) <= demo.VEL_TOL_PCT / 100 * true, row
+        assert true == 20000.0 and abs(mt - true) <= config.VEL_TOL_PCT / 100 * true, row
     assert "FAIL" not in vel and "REGISTERS != MODEL" not in vel
     vcd = TOP / "sim" / "waves" / "demo_test.vcd"
     assert vcd.stat().st_size < 50e6
-    found, _ = vcd_to_png.read_vcd(vcd, ["a_in", "b_in", "x4_count", "bcd_count"])
+    found, _ = vcd_png.read_vcd(vcd, ["a_in", "b_in", "x4_count", "bcd_count"])
     assert set(found) == {"a_in", "b_in", "x4_count", "bcd_count"}
     assert len(found["a_in"].changes) > 100
     assert png.stat().st_size > 10_000
@@ -100,5 +98,5 @@ def test_short_demo_run(tmp_path):
     shown = [line.split()[-1].split("[")[0] for line in (TOP / "sim" / "demo.gtkw").read_text().splitlines()
              if line.startswith("+") or (line[:1].isalpha() and "." in line)]
     assert len(shown) > 20
-    found, _ = vcd_to_png.read_vcd(vcd, shown, t_end_ps=0)
+    found, _ = vcd_png.read_vcd(vcd, shown, t_end_ps=0)
     assert sorted(set(shown) - set(found)) == [], "sim/demo.gtkw names signals the dump lacks"

@@ -22,15 +22,14 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-from enctools import toolenv
 import pytest
 
-TOP = Path(__file__).resolve().parents[2]
-
-from enctools import demo
-from enctools import vcd_png as vcd_to_png
+from enctools import toolenv
+from enctools import vcd_png
+from enctools.demo import config, options, plan as demo_plan
+from enctools.demo.gtkw import gtkw_text, gtkw_view, gtkw_view_lines
+from enctools.paths import TOP
 
 RPM = 20000                      # a short run: ~35k clocks, a few seconds on Icarus
 NAME = f"demo_gtkw_{os.getpid()}"
@@ -99,22 +98,22 @@ def short_run():
 def test_checked_in_save_file_is_the_default_runs(short_run):
     """sim/demo.gtkw = what `make demo` writes for the default options (regenerate it with
     ``scripts/demo.py --gtkw sim/demo.gtkw``), and its view is three cycles of that run."""
-    plan = demo.make_plan(demo.validate())
+    plan = demo_plan.make_plan(options.validate())
     # the bench starts the waveform a fixed number of clocks after time 0: the short run has the
     # default clock too, so its start is the default run's
     assert short_run["res"]["clk_ps"] == plan.clk_ps
     plan.t0_ps = short_run["res"]["t0_ps"]
-    assert demo.GTKW.read_text() == demo.gtkw_text(plan, demo.VCD, demo.GTKW), (
+    assert config.GTKW.read_text() == gtkw_text(plan, config.VCD, config.GTKW), (
         "sim/demo.gtkw is not the save file `make demo` writes for the default options; "
         "regenerate it: .venv/bin/python scripts/demo.py --gtkw sim/demo.gtkw")
-    v = demo.gtkw_view(plan)
+    v = gtkw_view(plan)
     h0, h1 = plan.seg["hold"]
     assert len(v["rises"]) == 4
     assert plan.t0_ps + h0 * 1e3 < v["start"] < v["rises"][0] < v["rises"][3] < v["end"] \
         < plan.t0_ps + h1 * 1e3, "the view is not inside the constant-speed hold"
     assert 2.9 * v["tau_ps"] < v["rises"][3] - v["rises"][0] < 3.1 * v["tau_ps"]
     # the file `make waves` opens after a short run is the one written for it (other view)
-    assert demo.gtkw_view_lines(short_run["gtkw"].read_text()) != demo.gtkw_view_lines(demo.GTKW.read_text())
+    assert gtkw_view_lines(short_run["gtkw"].read_text()) != gtkw_view_lines(config.GTKW.read_text())
 
 
 @pytest.mark.skipif(not (shutil.which("gtkwave") and shutil.which("xvfb-run")),
@@ -141,14 +140,14 @@ def test_gtkwave_opens_on_moving_signals(short_run, tmp_path):
     # the three cycles: the save file's named markers A-D, on the rising edges of A
     markers = [int(x) for x in next(ln for ln in text.splitlines() if ln.startswith("*")).split()[2:]]
     rises = [m for m in markers if m >= 0]
-    tau_ps = 1e12 / (RPM / 60.0 * demo.CPR)
+    tau_ps = 1e12 / (RPM / 60.0 * config.CPR)
     assert len(rises) == 4 and 2.9 * tau_ps < rises[3] - rises[0] < 3.1 * tau_ps, rises
     assert start <= rises[0] and rises[3] <= end, \
         f"visible {start}..{end} ps does not cover the three cycles {rises[0]}..{rises[3]} ps"
     assert end - start <= 6 * tau_ps, f"visible {end - start} ps: more than 6 cycles of {tau_ps:g} ps"
 
     # signals move inside the visible window
-    found, _ = vcd_to_png.read_vcd(vcd, [name.split("[")[0] for name, _ in MAIN], t_end_ps=end)
+    found, _ = vcd_png.read_vcd(vcd, [name.split("[")[0] for name, _ in MAIN], t_end_ps=end)
     for name, least in MAIN:
         n = sum(start <= t <= end for t, _ in found[name.split("[")[0]].changes)
         assert n >= least, f"{name}: {n} changes in the visible window, expected >= {least}"

@@ -10,22 +10,16 @@ from __future__ import annotations
 import argparse
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from enctools.paths import TOP
+from enctools.velocity import analyse, plan, sim_table, simulate
 from hedsmodel import EncoderUnit
 from hedsmodel.velocity import Timebase, edge_table, snapshot_trace
 
-TOP = Path(__file__).resolve().parents[2]
 SCRIPT = TOP / "scripts" / "velocity_bench.py"
-
-
-@pytest.fixture(scope="module")
-def bench():
-    from enctools import velocity_bench
-    return velocity_bench
 
 
 @pytest.mark.parametrize("argv,fragment", [
@@ -49,7 +43,7 @@ def test_bad_arguments_give_one_line(argv, fragment):
 
 
 def fake_raw(case, tb: Timebase, start_s: float, bits: dict):
-    """What velocity_bench_sim.py would record from an ideal enc_qei (clock 0 at sim time 0,
+    """What enctools.benches.velocity_sim would record from an ideal enc_qei (clock 0 at sim time 0,
     the waveform started at ``start_s``, a multiple of the clock period)."""
     clk = 1 / tb.clk_hz
     k0 = int(round(start_s / clk))
@@ -74,19 +68,19 @@ def fake_raw(case, tb: Timebase, start_s: float, bits: dict):
             "tb_cal": (k0 - 30) // (tb.prescale + 1), "reads": out}
 
 
-def test_sim_analysis_on_ideal_registers(bench):
+def test_sim_analysis_on_ideal_registers():
     args = argparse.Namespace(quick=True, sim_reads=6, stall_ms=200.0, prescale=0, clk_mhz=100.0,
                               seed=7, jobs=1)
-    regs, bits, a_rising = bench.reg_layout()
+    regs, bits, a_rising = simulate.reg_layout()
     assert a_rising == 1 and "SNAP_EDGE_DELTA" in regs
     units = [("ideal", EncoderUnit()), ("typical 1", EncoderUnit.typical(np.random.default_rng(7)))]
     rng = np.random.default_rng(7)
-    cases = bench.sim_cases(args, units, [30.0, 394.0, 12000.0], rng)
-    tb = bench.timebase(args)
+    cases = plan.sim_cases(args, units, [30.0, 394.0, 12000.0], rng)
+    tb = plan.timebase(args)
     results = []
     for c in cases:
         raw = fake_raw(c, tb, start_s=0.0123, bits=bits)
-        r = bench.analyse_case(c, raw, args, tb, bits)
+        r = analyse.analyse_case(c, raw, args, tb, bits)
         results.append(r)
         print(c["id"], r["latency_ticks"], r["checked"], {k: v.get("added_max")
                                                          for k, v in r["methods"].items()})
@@ -108,7 +102,7 @@ def test_sim_analysis_on_ideal_registers(bench):
             assert mt["zeros"] == 0
         else:
             assert r["checked"]["dir_flag"] > 0
-    rep = bench.sim_report(args, units, results, 1.0, "ideal registers", {})
+    rep = sim_table.sim_report(args, units, results, 1.0, "ideal registers", {})
     print("\n".join(rep["lines"] + rep["goals"]))
     assert rep["goals"] and all(g.startswith(("MET", "INFO")) for g in rep["goals"]), rep["goals"]
     assert len(rep["points"]) == 6

@@ -33,7 +33,7 @@ def field_kind(f) -> str:
     sw, hw = f.get_property("sw").name, f.get_property("hw").name
     onwrite = f.get_property("onwrite")
     ow = onwrite.name if onwrite is not None else None
-    if f.get_property("coherent"):
+    if _udp(f, "coherent"):
         return "coherent"
     if f.get_property("intr") and ow == "woclr" and sw == "rw":
         return "intr"
@@ -81,11 +81,24 @@ class Reg:
         return any(f.kind == "coherent" for f in self.fields.values())
 
 
+def _udp(node, name: str):
+    """A user-defined property; None in an RDL (of an older revision) that does not define it."""
+    try:
+        return node.get_property(name)
+    except LookupError:
+        return None
+
+
+def _feature(reg) -> str | None:
+    return _udp(reg, "feature")
+
+
 @lru_cache(maxsize=None)
-def regmap() -> dict[str, Reg]:
-    """Registers by name, in address order."""
+def regmap(path: Path = RDL) -> dict[str, Reg]:
+    """Registers by name, in address order (``path``: another RDL than rtl/enc_qei.rdl, e.g. the
+    one of a git revision a bench simulates)."""
     regs = {}
-    for r in compile_rdl().registers():
+    for r in compile_rdl(path).registers():
         fields = {}
         for f in r.fields():
             enc = f.get_property("encode")
@@ -93,7 +106,7 @@ def regmap() -> dict[str, Reg]:
                 f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
                 f.get_property("reset"), f.get_property("sized_by"),
                 {m.name: m.value for m in enc} if enc is not None else None, field_kind(f))
-        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, r.get_property("feature"), fields)
+        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, _feature(r), fields)
     return regs
 
 

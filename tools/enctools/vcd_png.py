@@ -7,8 +7,8 @@
 
 Signals are named by their last path component (or any suffix of the dotted path, e.g.
 ``demo_top.a_in``). One-bit signals are drawn as logic traces, wider ones as buses with their
-values written in (decimal; ``--hex NAME`` for BCD or hex). ``scripts/demo.py`` calls
-:func:`demo_figure` to make the README picture from the demo's own dump.
+values written in (decimal; ``--hex NAME`` for BCD or hex). The demo (enctools.demo.view) renders
+its README picture from its own dump with :func:`render`.
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+from .qei.bus import signed
 
 TIMESCALE_UNITS = {"s": 1e12, "ms": 1e9, "us": 1e6, "ns": 1e3, "ps": 1.0, "fs": 1e-3}
 
@@ -27,71 +29,78 @@ class Var:
         self.changes: list[tuple[float, str]] = []   # (time ps, value as a bit string)
 
 
-def read_vcd(path, wanted, t_end_ps: float | None = None):
-    """Read the signals named in ``wanted`` (suffixes of their dotted paths) from a VCD, up to
-    ``t_end_ps``. Returns ({wanted name: Var}, timescale in ps). Value strings are bits
-    ('0', '1', 'x', 'z', or a vector without the 'b')."""
+def _timescale_ps(spec: str) -> float:
+    num = "".join(c for c in spec if c.isdigit()) or "1"
+    unit = spec[len(num):] if spec.startswith(num) else spec.lstrip("0123456789")
+    return float(num) * TIMESCALE_UNITS.get(unit, 1.0)
+
+
+def _read_header(f, wanted):
+    """The definitions up to $enddefinitions: ({wanted name: Var}, {id code: [Var]}, timescale
+    in ps)."""
+    buf = []
+    for line in f:
+        buf.append(line)
+        if "$enddefinitions" in line:
+            break
+    header = " ".join(buf).split()
     scope: list[str] = []
     by_code: dict[str, list[Var]] = {}
     found: dict[str, Var] = {}
     ts_ps = 1.0
-    with open(path, "r", errors="replace") as f:
-        # ---- header
-        buf = []
-        for line in f:
-            buf.append(line)
-            if "$enddefinitions" in line:
+    i = 0
+    while i < len(header):
+        tok = header[i]
+        if tok == "$timescale":
+            j = header.index("$end", i)
+            ts_ps = _timescale_ps("".join(header[i + 1:j]))
+            i = j
+        elif tok == "$scope":
+            scope.append(header[i + 2])
+            i += 3
+        elif tok == "$upscope":
+            scope.pop()
+        elif tok == "$var":
+            j = header.index("$end", i)
+            width, code, name = int(header[i + 2]), header[i + 3], header[i + 4]
+            full = ".".join(scope + [name])
+            for w in wanted:
+                if w not in found and (full == w or full.endswith("." + w)):
+                    var = Var(full, width)
+                    found[w] = var
+                    by_code.setdefault(code, []).append(var)
+            i = j
+        i += 1
+    return found, by_code, ts_ps
+
+
+def _read_changes(f, by_code, ts_ps: float, t_end_ps: float | None) -> None:
+    """The value changes of the signals in ``by_code``, up to ``t_end_ps``."""
+    t = 0.0
+    for line in f:
+        if not line or line[0] == "$":
+            continue
+        c = line[0]
+        if c == "#":
+            t = float(line[1:]) * ts_ps
+            if t_end_ps is not None and t > t_end_ps:
                 break
-        header = " ".join(buf).split()
-        i = 0
-        while i < len(header):
-            tok = header[i]
-            if tok == "$timescale":
-                j = header.index("$end", i)
-                spec = "".join(header[i + 1:j])
-                num = "".join(c for c in spec if c.isdigit()) or "1"
-                unit = spec[len(num):] if spec.startswith(num) else spec.lstrip("0123456789")
-                ts_ps = float(num) * TIMESCALE_UNITS.get(unit, 1.0)
-                i = j
-            elif tok == "$scope":
-                scope.append(header[i + 2])
-                i += 3
-            elif tok == "$upscope":
-                scope.pop()
-            elif tok == "$var":
-                j = header.index("$end", i)
-                width, code, name = int(header[i + 2]), header[i + 3], header[i + 4]
-                full = ".".join(scope + [name])
-                for w in wanted:
-                    if w in found:
-                        continue
-                    if full == w or full.endswith("." + w):
-                        var = Var(full, width)
-                        found[w] = var
-                        by_code.setdefault(code, []).append(var)
-                i = j
-            i += 1
-        # ---- value changes
-        t = 0.0
-        for line in f:
-            if not line or line[0] == "$":
-                continue
-            c = line[0]
-            if c == "#":
-                t = float(line[1:]) * ts_ps
-                if t_end_ps is not None and t > t_end_ps:
-                    break
-            elif c in "01xzXZ":
-                vs = by_code.get(line[1:].strip())
-                if vs:
-                    for v in vs:
-                        v.changes.append((t, c.lower()))
-            elif c in "bBrR":
-                val, _, code = line[1:].strip().partition(" ")
-                vs = by_code.get(code)
-                if vs:
-                    for v in vs:
-                        v.changes.append((t, val.lower()))
+        elif c in "01xzXZ":
+            for v in by_code.get(line[1:].strip(), ()):
+                v.changes.append((t, c.lower()))
+        elif c in "bBrR":
+            val, _, code = line[1:].strip().partition(" ")
+            for v in by_code.get(code, ()):
+                v.changes.append((t, val.lower()))
+
+
+def read_vcd(path, wanted, t_end_ps: float | None = None):
+    """Read the signals named in ``wanted`` (suffixes of their dotted paths) from a VCD, up to
+    ``t_end_ps``. Returns ({wanted name: Var}, timescale in ps). Value strings are bits
+    ('0', '1', 'x', 'z', or a vector without the 'b')."""
+    with open(path, "r", errors="replace") as f:
+        found, by_code, ts_ps = _read_header(f, wanted)
+        _read_changes(f, by_code, ts_ps, t_end_ps)
     return found, ts_ps
 
 
@@ -110,9 +119,7 @@ def _fmt(bits: str, width: int, style: str) -> str:
     n = int(bits, 2)
     if style == "hex":
         return f"{n:0{(width + 3) // 4}x}"
-    if style == "signed" and n >= 1 << (width - 1):
-        n -= 1 << width
-    return str(n)
+    return str(signed(n, width) if style == "signed" else n)
 
 
 def draw(ax_rows, found, rows, t0_ps: float, t1_ps: float, unit_ps: float = 1e6):
@@ -188,24 +195,6 @@ def render(vcd, png, windows, rows=DEMO_ROWS, title=None):
     Path(png).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(png, dpi=110)
     plt.close(fig)
-
-
-def demo_figure(vcd, png, plan) -> None:
-    """The README picture: three cycles at constant peak speed, and two periods of the dither."""
-    tau_ps = 1e12 / (plan.opts.rpm / 60.0 * 500)
-    base = plan.t0_ps  # simulation time (ps) at which the model waveform starts
-    h0, h1 = plan.seg["hold"]
-    a = base + (h0 + h1) / 2 * 1000
-    d0, _ = plan.seg["dither"]
-    b = base + d0 * 1000
-    windows = [(a, a + 3 * tau_ps, f"{plan.opts.rpm:g} rpm forward, 3 cycles: 1X pulses once per cycle,\n"
-                                     "2X twice (each edge of A), 4X four times"),
-               (b, b + 2.2 * 5 * tau_ps, "shaft dithering about one edge of A: 4X and 2X count every "
-                                          "crossing,\nup and down (net 0); the 1X hysteresis counter "
-                                          "counts once")]
-    render(vcd, png, windows,
-           title=f"make demo: modeled HEDS-5000 ({plan.opts.rpm:g} rpm, {plan.opts.temp_c:g} degC), "
-                 f"clock {plan.clk_hz / 1e6:.4g} MHz - from sim/waves/demo.vcd")
 
 
 def main(argv=None) -> int:

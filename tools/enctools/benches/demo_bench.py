@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The cocotb side of `make demo` (scripts/demo.py): plays the modeled HEDS-5000 waveform into
-tb/hdl/demo_top.v and records what the circuits did. No verdicts here: scripts/demo.py compares
-the records with the model and prints the table.
+tb/hdl/demo_top.v and records what the circuits did. No verdicts here: enctools.demo compares the
+records with the model and prints the tables.
 
 The bus peripheral enc_qei_wb is read as a host would, over Wishbone through enctools.qei.bus's
 QeiBus (cocotbext-wishbone's WishboneMaster; register offsets and fields from the compiled
@@ -9,7 +9,7 @@ rtl/enc_qei.rdl): once the waveform starts, STALL_TIMEOUT and SNAP_CTRL.EDGE are
 planned read time a snapshot is commanded (SNAP_CTRL.CMD) and SNAP_COUNT_LO, SNAP_TIME,
 SNAP_EDGE_TIME, SNAP_DELTA, SNAP_EDGE_DELTA and STATUS are read; after the profile, COUNT.
 
-Environment (set by scripts/demo.py):
+Environment (set by enctools.demo.simulate):
   ENC_DEMO_PLAN      JSON: clk_ps, events [[t_ns, a, b]...], seg {name: [t0_ns, t1_ns]}, meas_rst_ns,
                  hold_test_ns, hold_test_clocks, back_mid_ns, qei {reads_ns [...], edge (an
                  SNAP_CTRL.EDGE member name), stall_ticks}
@@ -30,7 +30,7 @@ from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import play
 
-from enctools.tb import cocotb_test
+from enctools.tb import cocotb_test, until
 from hedsmodel.waveform import Waveform
 from enctools.qei.bus import QeiBus
 from enctools.regmap import get_field, pack
@@ -45,12 +45,6 @@ def _int(sig) -> int:
 
 def _signed(sig) -> int:
     return sig.value.to_signed()
-
-
-async def _until(t_ps: float) -> None:
-    now = get_sim_time("ps")
-    if t_ps > now:
-        await Timer(int(round(t_ps - now)), unit="ps")
 
 
 async def _record_rises(sig, out: list) -> None:
@@ -88,18 +82,23 @@ async def _progress(path: str, t0_ps: float, total_ns: float, seg: dict) -> None
         except OSError:
             pass
         t += step
-        await _until(t0_ps + t * 1000.0)
+        await until(t0_ps + t * 1000.0)
 
 
-async def _snapshot(dut, t_ps: float, names) -> dict:
-    await _until(t_ps)
+SNAP_SIGNALS = ("x1_count", "x2_count", "x4_count", "pm_a_leads", "pm_b_leads")
+
+
+async def _snapshot(dut, t_ps: float, key: str, out: dict) -> None:
+    """The counts and the phase meter's LEDs at ``t_ps``, as ``out[key]``."""
+    await until(t_ps)
     await ReadOnly()
-    return {n: _signed(getattr(dut, n)) if n.endswith("_count") and n.startswith("x")
-            else _int(getattr(dut, n)) for n in names}
+    out[key] = {n: _signed(getattr(dut, n)) if n.endswith("_count") and n.startswith("x")
+                else _int(getattr(dut, n)) for n in SNAP_SIGNALS}
 
 
-async def _pulse(dut, t_ps: float, sig_name: str, clk_ps: int) -> None:
-    await _until(t_ps)
+async def _pulse(dut, t_ps: float, sig_name: str) -> None:
+    """One clock of ``sig_name`` high, from the first falling clock edge after ``t_ps``."""
+    await until(t_ps)
     await FallingEdge(dut.clk)
     getattr(dut, sig_name).value = 1
     await FallingEdge(dut.clk)
@@ -109,7 +108,7 @@ async def _pulse(dut, t_ps: float, sig_name: str, clk_ps: int) -> None:
 async def _hold_test(dut, t_ps: float, clocks: int, out: dict) -> None:
     """Assert the buffer's read inhibit for `clocks` clocks: rd_data must not move while the
     count does, and must catch up within 2 clocks of release."""
-    await _until(t_ps)
+    await until(t_ps)
     await FallingEdge(dut.clk)
     dut.hold.value = 1
     await RisingEdge(dut.clk)      # rd_data takes its last value on this edge at the latest
@@ -141,23 +140,17 @@ async def _qei_reads(bus: QeiBus, t0_ps: float, qei: dict, out: list) -> None:
     await bus.wr("STALL_TIMEOUT", int(qei["stall_ticks"]))
     await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE=edge))
     for r_ns in qei["reads_ns"]:
-        await _until(t0_ps + r_ns * 1000.0)
+        await until(t0_ps + r_ns * 1000.0)
         await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
         t_ack = get_sim_time("ps")
-        words = {n: await bus.rd(n) for n in QEI_READS}
+        words = {n: await bus.rd(n) for n in QEI_READS}   # one bus cycle each, as a simple host
         words["stalled"] = get_field("STATUS", "STALLED", words["STATUS"])
         out.append({"t_ack_ps": t_ack, **words})
 
 
-@cocotb_test()
-async def demo(dut):
-    plan = json.loads(open(os.environ["ENC_DEMO_PLAN"]).read())
-    clk_ps = int(plan["clk_ps"])
-    events = [tuple(e) for e in plan["events"]]
-    wf = Waveform(events=events, positions=[0] * len(events))
-    seg = plan["seg"]
-    total_ns = max(b for _, b in seg.values())
-
+async def _start(dut, clk_ps: int, events: list) -> QeiBus:
+    """Clock, reset with the waveform's first state at the inputs, the Wishbone master idle;
+    returns the bus once reset is released."""
     cocotb.start_soon(Clock(dut.clk, clk_ps, unit="ps").start())
     dut.rst.value = 1
     dut.meas_rst.value = 0
@@ -172,59 +165,75 @@ async def demo(dut):
     for _ in range(3):
         await FallingEdge(dut.clk)
     dut.rst.value = 0
+    return bus
+
+
+async def _final(dut) -> dict:
+    """The counters and error tallies once the circuits have settled."""
+    for _ in range(50):
+        await FallingEdge(dut.clk)
+    await ReadOnly()
+    return {n: (_signed(getattr(dut, n)) if n.startswith("x") else _int(getattr(dut, n)))
+            for n in ("x1_count", "x2_count", "x4_count", "bcd_count", "bcd_rd", "n_glitch",
+                      "n_x1_err", "n_x2_err", "n_x4_err", "n_bcd_flag")}
+
+
+def _dither(snaps: dict, pulses: dict, window_ps: tuple) -> dict:
+    """Pulses inside the dither (up to 20 clocks after it) and the counts' net change across it."""
+    def inside(ts):
+        return len([t for t in ts if window_ps[0] <= t <= window_ps[1]])
+
+    ds, de = snaps.get("dither_start", {}), snaps.get("dither_end", {})
+    return {"x4_pulses": inside(pulses["x4"]),
+            "x1_pulses": inside(pulses["x1_up"]) + inside(pulses["x1_dn"]),
+            "x4_net": de["x4_count"] - ds["x4_count"],
+            "x2_net": de["x2_count"] - ds["x2_count"],
+            "x1_net": de["x1_count"] - ds["x1_count"]}
+
+
+@cocotb_test()
+async def demo(dut):
+    plan = json.loads(open(os.environ["ENC_DEMO_PLAN"]).read())
+    clk_ps = int(plan["clk_ps"])
+    events = [tuple(e) for e in plan["events"]]
+    wf = Waveform(events=events, positions=[0] * len(events))
+    seg = plan["seg"]
+    total_ns = max(b for _, b in seg.values())
+    bus = await _start(dut, clk_ps, events)
     await Timer(clk_ps // 3, unit="ps")  # start the waveform off the clock grid
     t0 = get_sim_time("ps")
 
-    a_rises, x1_up, x1_dn, x4_pulses = [], [], [], []
-    pm, ch = [], []
-    for coro in (_record_rises(dut.a, a_rises), _record_rises(dut.x1_up, x1_up),
-                 _record_rises(dut.x1_dn, x1_dn), _record_rises(dut.x4_pulse, x4_pulses),
+    a_rises, pm, ch = [], [], []
+    pulses = {"x1_up": [], "x1_dn": [], "x4": []}
+    for coro in (_record_rises(dut.a, a_rises), _record_rises(dut.x1_up, pulses["x1_up"]),
+                 _record_rises(dut.x1_dn, pulses["x1_dn"]), _record_rises(dut.x4_pulse, pulses["x4"]),
                  _record_pm(dut, pm), _record_ch(dut, ch)):
         cocotb.start_soon(coro)
     if os.environ.get("ENC_DEMO_PROGRESS"):
         cocotb.start_soon(_progress(os.environ["ENC_DEMO_PROGRESS"], t0, total_ns, seg))
-    cocotb.start_soon(_pulse(dut, t0 + plan["meas_rst_ns"] * 1000, "meas_rst", clk_ps))
+    cocotb.start_soon(_pulse(dut, t0 + plan["meas_rst_ns"] * 1000, "meas_rst"))
     hold_test: dict = {}
     cocotb.start_soon(_hold_test(dut, t0 + plan["hold_test_ns"] * 1000, plan["hold_test_clocks"],
                                  hold_test))
-    names = ("x1_count", "x2_count", "x4_count", "pm_a_leads", "pm_b_leads")
-    snaps = {}
-
-    async def snap(key, t_ns):
-        snaps[key] = await _snapshot(dut, t0 + t_ns * 1000, names)
-
+    snaps: dict = {}
     d0, d1 = seg["dither"]
-    h0, h1 = seg["hold"]
-    for key, t_ns in (("hold_end", h1 - 1000.0), ("back_mid", plan["back_mid_ns"]),
+    for key, t_ns in (("hold_end", seg["hold"][1] - 1000.0), ("back_mid", plan["back_mid_ns"]),
                       ("dither_start", d0), ("dither_end", d1 + 20 * clk_ps / 1000)):
-        cocotb.start_soon(snap(key, t_ns))
-
+        cocotb.start_soon(_snapshot(dut, t0 + t_ns * 1000, key, snaps))
     qei_reads: list = []
     qei_task = cocotb.start_soon(_qei_reads(bus, t0, plan["qei"], qei_reads))
 
     await play(dut, wf, "a_in", "b_in")
-    await _until(t0 + (total_ns + 1000.0) * 1000)
+    await until(t0 + (total_ns + 1000.0) * 1000)
     await qei_task
     qei_count = await bus.count()
-    for _ in range(50):
-        await FallingEdge(dut.clk)
-    await ReadOnly()
-    final = {n: (_signed(getattr(dut, n)) if n.startswith("x") else _int(getattr(dut, n)))
-             for n in ("x1_count", "x2_count", "x4_count", "bcd_count", "bcd_rd", "n_glitch",
-                       "n_x1_err", "n_x2_err", "n_x4_err", "n_bcd_flag")}
-    dps = (t0 + d0 * 1000, t0 + d1 * 1000 + 20 * clk_ps)
-    inside = lambda ts: [t for t in ts if dps[0] <= t <= dps[1]]
-    ds, de = snaps.get("dither_start", {}), snaps.get("dither_end", {})
+    final = await _final(dut)
     result = {
         "t0_ps": t0, "clk_ps": clk_ps, "final": final, "a_rises_ps": a_rises,
         "pm_readings": pm, "ch_readings": ch, "hold_test": hold_test,
         "leds": {"hold": [snaps["hold_end"]["pm_a_leads"], snaps["hold_end"]["pm_b_leads"]],
                  "back": [snaps["back_mid"]["pm_a_leads"], snaps["back_mid"]["pm_b_leads"]]},
-        "dither": {"x4_pulses": len(inside(x4_pulses)),
-                   "x1_pulses": len(inside(x1_up)) + len(inside(x1_dn)),
-                   "x4_net": de["x4_count"] - ds["x4_count"],
-                   "x2_net": de["x2_count"] - ds["x2_count"],
-                   "x1_net": de["x1_count"] - ds["x1_count"]},
+        "dither": _dither(snaps, pulses, (t0 + d0 * 1000, t0 + d1 * 1000 + 20 * clk_ps)),
         "snaps": snaps,
         "qei": {"reads": qei_reads, "count": qei_count},
     }

@@ -6,6 +6,7 @@
   module's tests again by themselves, as mutation testing does, without cocotb's internals.
 - ``start(dut, period_ps, ...)``: clock, seed logged, inputs driven, reset; returns the test's RNG.
 - ``current_seed()``: the seed cocotb gives the running test (regression seed + its full name).
+- ``until(t_ps)``: wait until an absolute simulation time (a bench playing a timed plan).
 
 Encoder stimulus comes from the installed packages ``hedsmodel`` (waveforms, the HEDS-5000 model)
 and ``cocotbext.quadrature`` (driver, monitor, clock).
@@ -19,7 +20,8 @@ import random
 from dataclasses import dataclass, field
 
 import cocotb
-from cocotb.triggers import FallingEdge
+from cocotb.triggers import FallingEdge, Timer
+from cocotb.utils import get_sim_time
 
 from cocotbext.quadrature import reset, start_clock
 
@@ -84,6 +86,13 @@ def log_seed(dut) -> int:
 async def reset_dut(dut, clocks: int = 2) -> None:
     """Hold ``dut.rst`` for ``clocks`` rising edges of ``dut.clk``, release after a falling edge."""
     await reset(dut.rst, dut.clk, clocks)
+
+
+async def until(t_ps: float) -> None:
+    """Wait until simulation time ``t_ps`` (ps; at once when it has passed)."""
+    now = get_sim_time("ps")
+    if t_ps > now:
+        await Timer(int(round(t_ps - now)), unit="ps")
 
 
 async def start(dut, period_ps: int, inputs: dict | None = None, do_reset: bool = True,
