@@ -815,6 +815,119 @@ module enc_qei_regs #(
     end
   end
 
+`ifdef FORMAL
+  reg [1151:0] f_view;
+  always @(*) begin
+    f_view = {1152{1'b0}};
+    f_view[0 +: 16] = 16'h100;  // ID.VERSION
+    f_view[16 +: 16] = 16'h5145;  // ID.MAGIC
+    f_view[32 +: 8] = hw2reg[7:0];
+    f_view[40 +: 8] = hw2reg[15:8];
+    f_view[48 +: 1] = hw2reg[16];
+    f_view[49 +: 1] = hw2reg[17];
+    f_view[50 +: 1] = hw2reg[18];
+    f_view[64 +: 1] = ctrl_en_q;
+    f_view[65 +: 1] = ctrl_swap_ab_q;
+    f_view[66 +: 1] = ctrl_inv_a_q;
+    f_view[67 +: 1] = ctrl_inv_b_q;
+    f_view[68 +: 1] = ctrl_inv_z_q;
+    f_view[72 +: 4] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
+    f_view[76 +: 2] = ctrl_range_q;
+    f_view[80 +: 5] = ctrl_filter_len_q;
+    f_view[96 +: 1] = hw2reg[19];
+    f_view[97 +: 1] = hw2reg[20];
+    f_view[98 +: 1] = hw2reg[21];
+    f_view[99 +: 1] = hw2reg[22];
+    f_view[100 +: 1] = hw2reg[23];
+    f_view[101 +: 1] = hw2reg[24];
+    f_view[102 +: 1] = hw2reg[25];
+    f_view[103 +: 1] = hw2reg[26];
+    f_view[128 +: 32] = hw2reg[58:27];
+    f_view[160 +: 32] = count_hi_latch_q;
+    f_view[192 +: 32] = preset_lo_value_q;
+    f_view[224 +: 32] = preset_hi_value_q;
+    f_view[256 +: 32] = ceiling_lo_value_q;
+    f_view[288 +: 32] = ceiling_hi_value_q;
+    f_view[320 +: 32] = compare_lo_value_q;
+    f_view[352 +: 32] = compare_hi_value_q;
+    f_view[384 +: 2] = index_ctrl_action_q;
+    f_view[386 +: 1] = index_ctrl_oneshot_q;
+    f_view[387 +: 1] = index_ctrl_edge_q;
+    f_view[388 +: 1] = index_ctrl_gate_en_q;
+    f_view[389 +: 1] = index_ctrl_gate_a_q;
+    f_view[390 +: 1] = index_ctrl_gate_b_q;
+    f_view[392 +: 1] = index_ctrl_arm_q;
+    f_view[416 +: 32] = hw2reg[123:92];
+    f_view[448 +: 32] = hw2reg[155:124];
+    f_view[480 +: 1] = probe_ctrl_en_q;
+    f_view[481 +: 1] = probe_ctrl_edge_q;
+    f_view[482 +: 1] = probe_ctrl_once_q;
+    f_view[512 +: 32] = hw2reg[188:157];
+    f_view[544 +: 32] = hw2reg[220:189];
+    f_view[576 +: 32] = hw2reg[252:221];
+    f_view[608 +: 1] = events_overflow_q;
+    f_view[609 +: 1] = events_underflow_q;
+    f_view[610 +: 1] = events_index_q;
+    f_view[611 +: 1] = events_probe_q;
+    f_view[612 +: 1] = events_cmp_q;
+    f_view[613 +: 1] = events_qerr_q;
+    f_view[614 +: 1] = events_glitch_q;
+    f_view[615 +: 1] = events_dir_change_q;
+    f_view[616 +: 1] = events_stall_q;
+    f_view[617 +: 1] = events_snap_ready_q;
+    f_view[618 +: 1] = events_period_ready_q;
+    f_view[619 +: 1] = events_period_ovf_q;
+    f_view[640 +: 12] = irq_en_en_q;
+    f_view[672 +: 16] = qerr_count_value_q;
+    f_view[704 +: 16] = glitch_count_value_q;
+    if (TIMING != 0) begin
+      f_view[736 +: 32] = hw2reg[298:267];
+    end
+    if (TIMING != 0) begin
+      f_view[768 +: 16] = tb_prescale_prescale_q;
+    end
+    if (TIMING != 0) begin
+      f_view[801 +: 1] = snap_ctrl_in_en_q;
+      f_view[802 +: 1] = snap_ctrl_period_en_q;
+      f_view[803 +: 1] = snap_ctrl_edge_q;
+    end
+    if (TIMING != 0) begin
+      f_view[832 +: 32] = snap_period_value_q;
+    end
+    if (TIMING != 0) begin
+      f_view[864 +: 32] = hw2reg[330:299];
+    end
+    if (TIMING != 0) begin
+      f_view[896 +: 32] = hw2reg[362:331];
+    end
+    if (TIMING != 0) begin
+      f_view[928 +: 32] = hw2reg[394:363];
+    end
+    if (TIMING != 0) begin
+      f_view[960 +: 32] = hw2reg[426:395];
+    end
+    if (TIMING != 0) begin
+      f_view[992 +: 32] = hw2reg[458:427];
+    end
+    if (TIMING != 0) begin
+      f_view[1024 +: 32] = hw2reg[490:459];
+    end
+    if (TIMING != 0) begin
+      f_view[1056 +: 1] = period_ctrl_en_q;
+      f_view[1057 +: 1] = period_ctrl_edge_q;
+      f_view[1064 +: 8] = period_ctrl_n_q;
+      f_view[1072 +: 1] = hw2reg[491];
+      f_view[1073 +: 1] = hw2reg[492];
+    end
+    if (TIMING != 0) begin
+      f_view[1088 +: 32] = hw2reg[524:493];
+    end
+    if (TIMING != 0) begin
+      f_view[1120 +: 32] = stall_timeout_value_q;
+    end
+  end
+`endif
+
   reg        resp_valid_q;
   reg [31:0] resp_rdata_q;
   reg        resp_err_q;

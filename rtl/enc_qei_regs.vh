@@ -155,8 +155,75 @@ localparam [0:0] ENC_QEI_EDGE_TYPE_ANY = 1'd0;
 localparam [0:0] ENC_QEI_EDGE_TYPE_A_RISING = 1'd1;
 localparam integer ENC_QEI_EDGE_TYPE_N = 2;
 
-// Bundle widths of the register block (rtl/enc_qei_regs.v, enc_qei_regs_fields.vh)
+// The register block's bundles (rtl/enc_qei_regs.v; the fields by name:
+// enc_qei_regs_fields.vh): widths, and the lsb of each field
 localparam integer ENC_QEI_R2H_W = 402, ENC_QEI_H2R_W = 525;
+localparam integer ENC_QEI_R2H_CTRL_EN = 0;
+localparam integer ENC_QEI_R2H_CTRL_SWAP_AB = 1;
+localparam integer ENC_QEI_R2H_CTRL_INV_A = 2;
+localparam integer ENC_QEI_R2H_CTRL_INV_B = 3;
+localparam integer ENC_QEI_R2H_CTRL_INV_Z = 4;
+localparam integer ENC_QEI_R2H_CTRL_FUNC = 5;
+localparam integer ENC_QEI_R2H_CTRL_RANGE = 9;
+localparam integer ENC_QEI_R2H_CTRL_FILTER_LEN = 11;
+localparam integer ENC_QEI_R2H_COUNT_LOAD = 16;
+localparam integer ENC_QEI_R2H_COUNT_LOAD_VALUE = 17;
+localparam integer ENC_QEI_R2H_PRESET = 81;
+localparam integer ENC_QEI_R2H_CEILING = 145;
+localparam integer ENC_QEI_R2H_COMPARE = 209;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_ACTION = 273;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_ONESHOT = 275;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_EDGE = 276;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_GATE_EN = 277;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_GATE_A = 278;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_GATE_B = 279;
+localparam integer ENC_QEI_R2H_INDEX_CTRL_ARM = 280;
+localparam integer ENC_QEI_R2H_PROBE_CTRL_EN = 281;
+localparam integer ENC_QEI_R2H_PROBE_CTRL_EDGE = 282;
+localparam integer ENC_QEI_R2H_PROBE_CTRL_ONCE = 283;
+localparam integer ENC_QEI_R2H_EVENTS = 284;
+localparam integer ENC_QEI_R2H_IRQ_EN_EN = 296;
+localparam integer ENC_QEI_R2H_TB_PRESCALE_PRESCALE = 308;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_CMD = 324;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_IN_EN = 325;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_PERIOD_EN = 326;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_EDGE = 327;
+localparam integer ENC_QEI_R2H_SNAP_PERIOD = 328;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EN = 360;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EDGE = 361;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_N = 362;
+localparam integer ENC_QEI_R2H_STALL_TIMEOUT = 370;
+localparam integer ENC_QEI_H2R_CAPS_COUNT_W = 0;
+localparam integer ENC_QEI_H2R_CAPS_TS_W = 8;
+localparam integer ENC_QEI_H2R_CAPS_INDEX = 16;
+localparam integer ENC_QEI_H2R_CAPS_PROBE = 17;
+localparam integer ENC_QEI_H2R_CAPS_TIMING = 18;
+localparam integer ENC_QEI_H2R_STATUS_A = 19;
+localparam integer ENC_QEI_H2R_STATUS_B = 20;
+localparam integer ENC_QEI_H2R_STATUS_Z = 21;
+localparam integer ENC_QEI_H2R_STATUS_DIR = 22;
+localparam integer ENC_QEI_H2R_STATUS_INDEX_ARMED = 23;
+localparam integer ENC_QEI_H2R_STATUS_STALLED = 24;
+localparam integer ENC_QEI_H2R_STATUS_STOPPED = 25;
+localparam integer ENC_QEI_H2R_STATUS_VALID = 26;
+localparam integer ENC_QEI_H2R_COUNT = 27;
+localparam integer ENC_QEI_H2R_INDEX_CTRL_ARM_CLR = 91;
+localparam integer ENC_QEI_H2R_INDEX_LATCH = 92;
+localparam integer ENC_QEI_H2R_PROBE_CTRL_EN_CLR = 156;
+localparam integer ENC_QEI_H2R_PROBE_LATCH = 157;
+localparam integer ENC_QEI_H2R_PROBE_TIME = 221;
+localparam integer ENC_QEI_H2R_EVENTS_SET = 253;
+localparam integer ENC_QEI_H2R_QERR_COUNT_INCR = 265;
+localparam integer ENC_QEI_H2R_GLITCH_COUNT_INCR = 266;
+localparam integer ENC_QEI_H2R_TIMEBASE = 267;
+localparam integer ENC_QEI_H2R_SNAP_COUNT = 299;
+localparam integer ENC_QEI_H2R_SNAP_TIME = 363;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_TIME = 395;
+localparam integer ENC_QEI_H2R_SNAP_DELTA = 427;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_DELTA = 459;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_OVERFLOW = 491;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_DIR_CHANGE = 492;
+localparam integer ENC_QEI_H2R_PERIOD = 493;
 // verilator lint_on UNUSEDPARAM
 
 // 1: the byte address is a register of the map (bits 1:0 ignored)

@@ -34,18 +34,11 @@ needs_gcc = pytest.mark.skipif(GCC is None, reason="gcc not installed")
 
 @lru_cache(maxsize=None)
 def rdl():
-    """{register: {field: (lsb, width, {member: value} or None)}} from the compiled RDL (the same
-    compile as the generators: enctools.regmap)."""
-    from enctools.regmap import compile_rdl
+    """{register: {field: (lsb, width, {member: value} or None)}}: a view of enctools.regmap."""
+    from enctools.regmap import regmap
 
-    out = {}
-    for r in compile_rdl().registers():
-        fields = {}
-        for f in r.fields():
-            enc = f.get_property("encode")
-            fields[f.inst_name] = (f.lsb, f.width, {m.name: m.value for m in enc} if enc else None)
-        out[r.inst_name] = fields
-    return out
+    return {r.name: {f.name: (f.lsb, f.width, f.enum) for f in r.fields.values()}
+            for r in regmap().values()}
 
 
 def fv(reg: str, field: str, value) -> int:

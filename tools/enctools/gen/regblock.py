@@ -234,7 +234,9 @@ class Writer:
                 out.append(f"    if (rd_sel_q[{k}]) begin  // {rn}")
                 out += ["      " + self.or_in(r) for r in reads]
                 out.append("    end")
-        out += ["  end", "", "  reg        resp_valid_q;", "  reg [31:0] resp_rdata_q;", "  reg        resp_err_q;", "",
+        out += ["  end", ""]
+        out += self.formal_view()
+        out += ["  reg        resp_valid_q;", "  reg [31:0] resp_rdata_q;", "  reg        resp_err_q;", "",
                 "  always @(posedge clk) begin", "    if (rst) begin", "      resp_valid_q <= 1'b0;",
                 "      resp_rdata_q <= 32'd0;", "      resp_err_q   <= 1'b0;", "    end else begin",
                 "      resp_valid_q <= pend_q;", "      resp_rdata_q <= rd_d;", "      resp_err_q   <= err_q;",
@@ -264,6 +266,27 @@ class Writer:
             out.append(f"  assign reg2hw{rng} = {end - bit + 1}'d0;  // (no field)")
             bit = end + 1
         return out + ([""] if out else [])
+
+    def formal_view(self) -> list[str]:
+        """Under FORMAL: f_view, every register's value as a read would answer it now (register k
+        in bits [32k +: 32]); formal/enc_qei_regs.sby connects it to its wrapper, whose
+        k-induction needs the stored values (the ports show them only when read)."""
+        n = len(self.reads)
+        out = ["`ifdef FORMAL", f"  reg [{32 * n - 1}:0] f_view;", "  always @(*) begin",
+               f"    f_view = {{{32 * n}{{1'b0}}}};"]
+        for k, (rn, reads) in enumerate(self.reads):
+            for r in reads:
+                stripped = r.strip()
+                if stripped.startswith("rd_d"):
+                    lhs, rest = stripped.split(" = ", 1)
+                    rng = lhs[4:] or "[31:0]"
+                    hi, _, lo = rng.strip("[]").partition(":")
+                    lo = lo or hi
+                    w = int(hi) - int(lo) + 1
+                    out.append(f"{' ' * (len(r) - len(r.lstrip()) + 4)}f_view[{32 * k + int(lo)} +: {w}] = {rest}")
+                else:
+                    out.append("    " + r)
+        return out + ["  end", "`endif", ""]
 
     @staticmethod
     def or_in(line: str) -> str:

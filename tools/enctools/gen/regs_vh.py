@@ -52,8 +52,11 @@ def render(top) -> str:
                          f"{width}'d{m.value};")
         lines.append(f"localparam integer ENC_QEI_{name}_N = {len(members)};")
     b = build(top)
-    lines += ["", "// Bundle widths of the register block (rtl/enc_qei_regs.v, enc_qei_regs_fields.vh)",
+    lines += ["", "// The register block's bundles (rtl/enc_qei_regs.v; the fields by name:",
+              "// enc_qei_regs_fields.vh): widths, and the lsb of each field",
               f"localparam integer ENC_QEI_R2H_W = {b.r2h_w}, ENC_QEI_H2R_W = {b.h2r_w};"]
+    lines += [f"localparam integer ENC_QEI_R2H_{e.name.upper()} = {e.lsb};" for e in b.r2h]
+    lines += [f"localparam integer ENC_QEI_H2R_{e.name.upper()} = {e.lsb};" for e in b.h2r]
     idx = sorted(r.address_offset >> 2 for r in regs)
     lines += ["// verilator lint_on UNUSEDPARAM", "",
               "// 1: the byte address is a register of the map (bits 1:0 ignored)",
