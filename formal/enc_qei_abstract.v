@@ -7,7 +7,8 @@
 // contract on the real enc_qei):
 //   - resp_valid exactly two clocks after req_valid (a request in a clock with rst high, or in
 //     flight when rst rises, gets none);
-//   - resp_err = the request's offset is unmapped (enc_qei_mapped() of rtl/enc_qei_regs.vh);
+//   - resp_err = the request's offset is unmapped (enc_qei_mapped(addr, CHANNELS) of
+//     rtl/enc_qei_regs.vh);
 //   - resp_rdata: a read of a mapped offset f_qei_rdata(addr) (formal/enc_qei_abstract.vh), an
 //     unmapped read or a write 0;
 //   - outside resp_valid, resp_err and resp_rdata take any value at every clock (the adapters
@@ -17,6 +18,8 @@
 `default_nettype none
 
 module enc_qei #(
+    parameter integer CHANNELS   = 1,
+    parameter integer ADDR_W     = 8,
     parameter integer COUNT_W    = 32,
     parameter integer TS_W       = 32,
     parameter integer PROFILE    = 2,
@@ -26,19 +29,19 @@ module enc_qei #(
     input  wire        rst,
     input  wire        req_valid,
     input  wire        req_write,
-    input  wire [7:0]  req_addr,
+    input  wire [ADDR_W-1:0] req_addr,
     input  wire [31:0] req_wdata,
     input  wire [3:0]  req_wstrb,
     output wire        resp_valid,
     output wire [31:0] resp_rdata,
     output wire        resp_err,
-    input  wire        a_in,
-    input  wire        b_in,
-    input  wire        z_in,
-    input  wire        probe_in,
+    input  wire [CHANNELS-1:0] a_in,
+    input  wire [CHANNELS-1:0] b_in,
+    input  wire [CHANNELS-1:0] z_in,
+    input  wire [CHANNELS-1:0] probe_in,
     input  wire        snap_in,
     output wire        irq,
-    output wire        cmp_out
+    output wire [CHANNELS-1:0] cmp_out
 );
 
 `include "enc_qei_regs.vh"
@@ -46,7 +49,7 @@ module enc_qei #(
 
   reg        v1_q = 1'b0, v2_q = 1'b0;  // a request one / two clocks ago
   reg        w1_q;
-  reg [7:0]  a1_q;
+  reg [15:0] a1_q;  // the request's address, zero-extended
   reg        err2_q;
   reg [31:0] rdata2_q;
 
@@ -59,19 +62,20 @@ module enc_qei #(
       v2_q <= v1_q;
     end
     w1_q     <= req_write;
-    a1_q     <= req_addr;
-    err2_q   <= ~enc_qei_mapped(a1_q);
-    rdata2_q <= (w1_q | ~enc_qei_mapped(a1_q)) ? 32'd0 : f_qei_rdata(a1_q);
+    a1_q     <= req_addr;  // zero-extended
+    err2_q   <= ~enc_qei_mapped(a1_q, CHANNELS);
+    rdata2_q <= (w1_q | ~enc_qei_mapped(a1_q, CHANNELS)) ? 32'd0 : f_qei_rdata(a1_q);
   end
 
-  wire [31:0] any_rdata = $anyseq;
+  wire [31:0]         any_rdata = $anyseq;
   wire        any_err   = $anyseq;
 
   assign resp_valid = v2_q;
   assign resp_err   = v2_q ? err2_q : any_err;
   assign resp_rdata = v2_q ? rdata2_q : any_rdata;
   assign irq        = $anyseq;
-  assign cmp_out    = $anyseq;
+  wire [CHANNELS-1:0] any_cmp   = $anyseq;
+  assign cmp_out    = any_cmp;
 
   always @(*) begin
     if (!rst && req_valid) assert (!v1_q && !v2_q);

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Formal wrapper for enc_qei_axil (read by formal/enc_qei_axil.sby; `make formal`).
 //
-// The adapter at its default parameters, around the abstract enc_qei of
-// formal/enc_qei_abstract.v (read instead of rtl/enc_qei.v): responses exactly two clocks after a
-// request, resp_err = unmapped offset, read data f_qei_rdata(addr) (0 unmapped). The adapter
-// logic does not depend on COUNT_W, TS_W, PROFILE or FUNC_MASK; the real enc_qei's side of the
-// contract is proven by formal/enc_qei_port.sby.
+// The adapter around the abstract enc_qei of formal/enc_qei_abstract.v (read instead of
+// rtl/enc_qei.v): responses exactly two clocks after a request, resp_err = unmapped offset (for
+// the wrapper's CHANNELS), read data f_qei_rdata(addr) (0 unmapped). The adapter logic does not
+// depend on COUNT_W, TS_W, PROFILE or FUNC_MASK, and on CHANNELS only through ADDR_W; the real
+// enc_qei's side of the contract is proven by formal/enc_qei_port.sby.
 //
 // Assumptions: the first clock is a reset; formal/faxil_slave.v's master (valids low after a
 // reset clock, a VALID held with a stable payload until its READY) with the fairness bound: BREADY
@@ -31,29 +31,32 @@
 //     pend_q, pend_wr_q, last_rd_q: the k-induction needs them, that state being invisible at
 //     the ports for as long as the master withholds the other half of a write).
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei_axil_formal #(
     parameter integer STALL = 3,   // master fairness: BREADY / RREADY low at most this long
     parameter integer WAIT  = 15,  // slave: most clocks a VALID waits for its READY
-    parameter integer DELAY = 12   // slave: most clocks a complete request waits for B / R
+    parameter integer DELAY = 12,  // slave: most clocks a complete request waits for B / R
+    parameter integer CHANNELS = 1,  // the adapter's channels (its address decode)
+    parameter integer AW = `ENC_QEI_ADDR_W(CHANNELS)  // its byte address bits
 ) (
     input wire        clk,
     input wire        rst,
-    input wire [7:0]  s_axil_awaddr,
+    input wire [AW-1:0] s_axil_awaddr,
     input wire [2:0]  s_axil_awprot,
     input wire        s_axil_awvalid,
     input wire [31:0] s_axil_wdata,
     input wire [3:0]  s_axil_wstrb,
     input wire        s_axil_wvalid,
     input wire        s_axil_bready,
-    input wire [7:0]  s_axil_araddr,
+    input wire [AW-1:0] s_axil_araddr,
     input wire [2:0]  s_axil_arprot,
     input wire        s_axil_arvalid,
     input wire        s_axil_rready,
-    input wire        a_in,
-    input wire        b_in,
-    input wire        z_in,
-    input wire        probe_in,
+    input wire [CHANNELS-1:0] a_in,
+    input wire [CHANNELS-1:0] b_in,
+    input wire [CHANNELS-1:0] z_in,
+    input wire [CHANNELS-1:0] probe_in,
     input wire        snap_in
 );
 
@@ -63,9 +66,13 @@ module enc_qei_axil_formal #(
   wire        s_axil_awready, s_axil_wready, s_axil_bvalid, s_axil_arready, s_axil_rvalid;
   wire [1:0]  s_axil_bresp, s_axil_rresp;
   wire [31:0] s_axil_rdata;
-  wire        irq, cmp_out;
+  wire        irq;
+  wire [CHANNELS-1:0] cmp_out;
 
-  enc_qei_axil dut (
+  enc_qei_axil #(
+      .CHANNELS(CHANNELS),
+      .ADDR_W  (AW)
+  ) dut (
       .clk           (clk),
       .rst           (rst),
       .s_axil_awaddr (s_axil_awaddr),
@@ -98,16 +105,16 @@ module enc_qei_axil_formal #(
 
   // Probes, connected by the .sby after flatten: the adapter's skid registers, its pending flags
   // and its enc_qei port (dut.u_qei.req_*).
-  (* keep *) wire [7:0]  p_awaddr_q;
+  (* keep *) wire [AW-1:0] p_awaddr_q;
   (* keep *) wire [31:0] p_wdata_q;
   (* keep *) wire [3:0]  p_wstrb_q;
-  (* keep *) wire [7:0]  p_araddr_q;
+  (* keep *) wire [AW-1:0] p_araddr_q;
   (* keep *) wire        p_pend_q;
   (* keep *) wire        p_pend_wr_q;
   (* keep *) wire        p_last_rd_q;
   (* keep *) wire        p_req_valid;
   (* keep *) wire        p_req_write;
-  (* keep *) wire [7:0]  p_req_addr;
+  (* keep *) wire [AW-1:0] p_req_addr;
   (* keep *) wire [31:0] p_req_wdata;
   (* keep *) wire [3:0]  p_req_wstrb;
 
@@ -116,12 +123,12 @@ module enc_qei_axil_formal #(
   always @(*) if (!f_past_valid) assume (rst);
 
   wire [1:0]  f_awr_out, f_wr_out, f_rd_out;
-  wire [15:0] f_awq, f_arq;
+  wire [2*AW-1:0] f_awq, f_arq;
   wire [63:0] f_wq;
   wire [7:0]  f_wsq;
 
   faxil_slave #(
-      .AW               (8),
+      .AW               (AW),
       .DW               (32),
       .F_MAX_OUTSTANDING(2),
       .F_MAX_STALL      (STALL),
@@ -163,14 +170,17 @@ module enc_qei_axil_formal #(
 
   // the oldest unanswered request of each channel (the one the next response answers) and the
   // newest accepted one (the one a skid register may hold)
-  wire [7:0]  aw_old = f_awq[7:0];
+  wire [AW-1:0] aw_old = f_awq[AW-1:0];
   wire [31:0] w_old  = f_wq[31:0];
   wire [3:0]  ws_old = f_wsq[3:0];
-  wire [7:0]  ar_old = f_arq[7:0];
-  wire [7:0]  aw_new = (f_awr_out == 2'd2) ? f_awq[15:8] : f_awq[7:0];
+  wire [AW-1:0] ar_old = f_arq[AW-1:0];
+  wire [AW-1:0] aw_new = (f_awr_out == 2'd2) ? f_awq[2*AW-1:AW] : f_awq[AW-1:0];
   wire [31:0] w_new  = (f_wr_out == 2'd2) ? f_wq[63:32] : f_wq[31:0];
   wire [3:0]  ws_new = (f_wr_out == 2'd2) ? f_wsq[7:4] : f_wsq[3:0];
-  wire [7:0]  ar_new = (f_rd_out == 2'd2) ? f_arq[15:8] : f_arq[7:0];
+  wire [AW-1:0] ar_new = (f_rd_out == 2'd2) ? f_arq[2*AW-1:AW] : f_arq[AW-1:0];
+  // ... zero-extended for the map's functions
+  wire [15:0] aw_old16 = aw_old;
+  wire [15:0] ar_old16 = ar_old;
 
   // requests given to enc_qei (seen on its port) whose response has not been taken on the bus
   reg [1:0] f_wr_given = 2'd0, f_rd_given = 2'd0;
@@ -192,10 +202,12 @@ module enc_qei_axil_formal #(
   always @(*) begin
     if (f_past_valid && !rst) begin
       // responses: SLVERR exactly for an unmapped address; read data
-      if (s_axil_bvalid) assert (s_axil_bresp == (enc_qei_mapped(aw_old) ? OKAY : SLVERR));
+      if (s_axil_bvalid) begin
+        assert (s_axil_bresp == (enc_qei_mapped(aw_old16, CHANNELS) ? OKAY : SLVERR));
+      end
       if (s_axil_rvalid) begin
-        assert (s_axil_rresp == (enc_qei_mapped(ar_old) ? OKAY : SLVERR));
-        assert (s_axil_rdata == (enc_qei_mapped(ar_old) ? f_qei_rdata(ar_old) : 32'd0));
+        assert (s_axil_rresp == (enc_qei_mapped(ar_old16, CHANNELS) ? OKAY : SLVERR));
+        assert (s_axil_rdata == (enc_qei_mapped(ar_old16, CHANNELS) ? f_qei_rdata(ar_old16) : 32'd0));
       end
       // every accepted request given to enc_qei once: the accepted ones not held in a skid
       // register; one at a time

@@ -10,39 +10,45 @@
 // Proven (k-induction), with a shadow of the requests of the last two clocks:
 //   - resp_valid exactly two clocks after req_valid, none for a request in a clock with rst
 //     high or in flight when rst rises: one response per request, none without one;
-//   - resp_err exactly when that request's offset is unmapped (!enc_qei_mapped(req_addr) of
-//     rtl/enc_qei_regs.vh);
+//   - resp_err exactly when that request's offset is unmapped (!enc_qei_mapped(req_addr,
+//     CHANNELS) of rtl/enc_qei_regs.vh);
 //   - resp_rdata 0 for a read of an unmapped offset and for every write (the port's rule).
 // Not here (the register block's own properties): what a mapped read returns, that an unmapped
 // write changes nothing, byte enables.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei_port_formal #(
     parameter integer COUNT_W   = 32,
     parameter integer TS_W      = 32,
     parameter integer PROFILE   = 2,
-    parameter integer FUNC_MASK = 511
+    parameter integer FUNC_MASK = 511,
+    parameter integer CHANNELS  = 1,
+    parameter integer AW        = `ENC_QEI_ADDR_W(CHANNELS)  // byte address bits
 ) (
     input wire        clk,
     input wire        rst,
     input wire        req_valid,
     input wire        req_write,
-    input wire [7:0]  req_addr,
+    input wire [AW-1:0] req_addr,
     input wire [31:0] req_wdata,
     input wire [3:0]  req_wstrb,
-    input wire        a_in,
-    input wire        b_in,
-    input wire        z_in,
-    input wire        probe_in,
+    input wire [CHANNELS-1:0] a_in,
+    input wire [CHANNELS-1:0] b_in,
+    input wire [CHANNELS-1:0] z_in,
+    input wire [CHANNELS-1:0] probe_in,
     input wire        snap_in
 );
 
 `include "enc_qei_regs.vh"
 
-  wire        resp_valid, resp_err, irq, cmp_out;
+  wire        resp_valid, resp_err, irq;
+  wire [CHANNELS-1:0] cmp_out;
   wire [31:0] resp_rdata;
 
   enc_qei #(
+      .CHANNELS (CHANNELS),
+      .ADDR_W   (AW),
       .COUNT_W  (COUNT_W),
       .TS_W     (TS_W),
       .PROFILE  (PROFILE),
@@ -71,13 +77,15 @@ module enc_qei_port_formal #(
   always @(posedge clk) f_past_valid <= 1'b1;
   always @(*) if (!f_past_valid) assume (rst);
 
+  wire [15:0] f_addr16 = req_addr;  // zero-extended for the map's function
+
   // the requests of one and two clocks ago: valid, unmapped, write
   reg f_v1 = 1'b0, f_v2 = 1'b0;
   reg f_u1, f_u2, f_w1, f_w2;
   always @(posedge clk) begin
     f_v1 <= !rst && req_valid;
     f_v2 <= !rst && f_v1;
-    f_u1 <= !enc_qei_mapped(req_addr);
+    f_u1 <= !enc_qei_mapped(f_addr16, CHANNELS);
     f_u2 <= f_u1;
     f_w1 <= req_write;
     f_w2 <= f_w1;

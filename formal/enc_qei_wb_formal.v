@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Formal wrapper for enc_qei_wb (read by formal/enc_qei_wb.sby; `make formal`).
 //
-// The adapter at its default parameters, around the abstract enc_qei of
-// formal/enc_qei_abstract.v (the .sby reads it instead of rtl/enc_qei.v): responses exactly two
-// clocks after a request, resp_err = unmapped offset, read data f_qei_rdata(addr) (0 unmapped);
-// the adapter logic does not depend on COUNT_W, TS_W, PROFILE or FUNC_MASK. The real enc_qei's
+// The adapter around the abstract enc_qei of formal/enc_qei_abstract.v (the .sby reads it
+// instead of rtl/enc_qei.v): responses exactly two clocks after a request, resp_err = unmapped
+// offset (for the wrapper's CHANNELS), read data f_qei_rdata(addr) (0 unmapped); the adapter
+// logic does not depend on COUNT_W, TS_W, PROFILE or FUNC_MASK, and on CHANNELS only through
+// ADDR_W. The real enc_qei's
 // side of that contract is proven by formal/enc_qei_port.sby.
 //
 // Assumptions: the first clock is a reset; formal/fwb_slave.v's classic master (stb only with
@@ -30,22 +31,25 @@
 // one, which it carries out but does not answer) and the request need not reach enc_qei in its
 // first clock, everything else as above.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei_wb_formal #(
-    parameter [0:0] ABORT = 1'b0  // 1: the master may abort a request by dropping cyc
+    parameter [0:0] ABORT = 1'b0,  // 1: the master may abort a request by dropping cyc
+    parameter integer CHANNELS = 1,  // the adapter's channels (its address decode)
+    parameter integer AW = `ENC_QEI_ADDR_W(CHANNELS)  // its byte address bits
 ) (
     input wire        clk,
     input wire        rst,
-    input wire [7:0]  wb_adr_i,
+    input wire [AW-1:0] wb_adr_i,
     input wire [31:0] wb_dat_i,
     input wire [3:0]  wb_sel_i,
     input wire        wb_we_i,
     input wire        wb_stb_i,
     input wire        wb_cyc_i,
-    input wire        a_in,
-    input wire        b_in,
-    input wire        z_in,
-    input wire        probe_in,
+    input wire [CHANNELS-1:0] a_in,
+    input wire [CHANNELS-1:0] b_in,
+    input wire [CHANNELS-1:0] z_in,
+    input wire [CHANNELS-1:0] probe_in,
     input wire        snap_in
 );
 
@@ -53,9 +57,13 @@ module enc_qei_wb_formal #(
 `include "enc_qei_abstract.vh"
 
   wire [31:0] wb_dat_o;
-  wire        wb_ack_o, wb_err_o, irq, cmp_out;
+  wire        wb_ack_o, wb_err_o, irq;
+  wire [CHANNELS-1:0] cmp_out;
 
-  enc_qei_wb dut (
+  enc_qei_wb #(
+      .CHANNELS(CHANNELS),
+      .ADDR_W  (AW)
+  ) dut (
       .clk     (clk),
       .rst     (rst),
       .wb_adr_i(wb_adr_i),
@@ -82,7 +90,7 @@ module enc_qei_wb_formal #(
   (* keep *) wire        p_held_q;
   (* keep *) wire        p_req_valid;
   (* keep *) wire        p_req_write;
-  (* keep *) wire [7:0]  p_req_addr;
+  (* keep *) wire [AW-1:0] p_req_addr;
   (* keep *) wire [31:0] p_req_wdata;
   (* keep *) wire [3:0]  p_req_wstrb;
 
@@ -95,7 +103,7 @@ module enc_qei_wb_formal #(
   wire [3:0] f_nreqs, f_nacks, f_outstanding;
 
   fwb_slave #(
-      .AW         (8),
+      .AW         (AW),
       .DW         (32),
       .F_MIN_DELAY(ABORT ? 0 : 2),
       .F_MAX_DELAY(ABORT ? 4 : 2),
@@ -122,7 +130,8 @@ module enc_qei_wb_formal #(
   );
 
   wire f_answer = wb_ack_o | wb_err_o;
-  wire f_mapped = enc_qei_mapped(wb_adr_i);
+  wire [15:0] f_adr16 = wb_adr_i;  // zero-extended for the map's functions
+  wire f_mapped = enc_qei_mapped(f_adr16, CHANNELS);
 
   // requests on the enc_qei port one and two clocks ago: in flight (its response is due)
   reg f_q1 = 1'b0, f_q2 = 1'b0;
@@ -144,7 +153,7 @@ module enc_qei_wb_formal #(
       // err exactly for an unmapped offset
       if (f_answer) assert (wb_err_o == !f_mapped);
       // read data: enc_qei's for that address, 0 unmapped
-      if (f_answer && !wb_we_i) assert (wb_dat_o == (f_mapped ? f_qei_rdata(wb_adr_i) : 32'd0));
+      if (f_answer && !wb_we_i) assert (wb_dat_o == (f_mapped ? f_qei_rdata(f_adr16) : 32'd0));
       // the request reaches enc_qei once, in its first clock, as it is on the bus
       if (!ABORT) assert (p_req_valid == f_start);
       if (p_req_valid) begin

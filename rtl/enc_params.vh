@@ -13,7 +13,9 @@
 `define ENC_CHECK_WINDOW_CYCLES if (WINDOW_CYCLES < 1 || WINDOW_CYCLES > 16384) begin : g_bad_window_cycles enc__parameter_WINDOW_CYCLES_must_be_1_to_16384 u_stop (); end
 `define ENC_CHECK_COUNT_W if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w enc__parameter_COUNT_W_must_be_8_to_64 u_stop (); end
 `define ENC_CHECK_TS_W if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w enc__parameter_TS_W_must_be_16_to_32 u_stop (); end
-`define ENC_CHECK_PROFILE if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile enc__parameter_PROFILE_must_be_1_to_2 u_stop (); end
+`define ENC_CHECK_PROFILE if (PROFILE < 1 || PROFILE > 3) begin : g_bad_profile enc__parameter_PROFILE_must_be_1_to_3 u_stop (); end
+`define ENC_CHECK_CHANNELS if (CHANNELS < 1 || CHANNELS > 16) begin : g_bad_channels enc__parameter_CHANNELS_must_be_1_to_16 u_stop (); end
+`define ENC_CHECK_ADDR_W if (ADDR_W < 8 || ADDR_W > 16) begin : g_bad_addr_w enc__parameter_ADDR_W_must_be_8_to_16 u_stop (); end
 `define ENC_CHECK_FUNC_MASK if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask enc__parameter_FUNC_MASK_must_be_1_to_511 u_stop (); end
 `define ENC_CHECK_MAX_FILTER_LEN if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len enc__parameter_MAX_FILTER_LEN_must_be_1_to_16 u_stop (); end
 `define ENC_CHECK_POS_WIDTH if (POS_WIDTH < 8 || POS_WIDTH > 31) begin : g_bad_pos_width enc__parameter_POS_WIDTH_must_be_8_to_31 u_stop (); end
@@ -28,11 +30,18 @@
 `define ENC_CHECK_WINDOW_CYCLES if (WINDOW_CYCLES < 1 || WINDOW_CYCLES > 16384) begin : g_bad_window_cycles $error("parameter WINDOW_CYCLES must be in 1 .. 16384"); end
 `define ENC_CHECK_COUNT_W if (COUNT_W < 8 || COUNT_W > 64) begin : g_bad_count_w $error("parameter COUNT_W must be in 8 .. 64"); end
 `define ENC_CHECK_TS_W if (TS_W < 16 || TS_W > 32) begin : g_bad_ts_w $error("parameter TS_W must be in 16 .. 32"); end
-`define ENC_CHECK_PROFILE if (PROFILE < 1 || PROFILE > 2) begin : g_bad_profile $error("parameter PROFILE must be in 1 .. 2"); end
+`define ENC_CHECK_PROFILE if (PROFILE < 1 || PROFILE > 3) begin : g_bad_profile $error("parameter PROFILE must be in 1 .. 3"); end
+`define ENC_CHECK_CHANNELS if (CHANNELS < 1 || CHANNELS > 16) begin : g_bad_channels $error("parameter CHANNELS must be in 1 .. 16"); end
+`define ENC_CHECK_ADDR_W if (ADDR_W < 8 || ADDR_W > 16) begin : g_bad_addr_w $error("parameter ADDR_W must be in 8 .. 16"); end
 `define ENC_CHECK_FUNC_MASK if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask $error("parameter FUNC_MASK must be in 1 .. 511"); end
 `define ENC_CHECK_MAX_FILTER_LEN if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len $error("parameter MAX_FILTER_LEN must be in 1 .. 16"); end
 `define ENC_CHECK_POS_WIDTH if (POS_WIDTH < 8 || POS_WIDTH > 31) begin : g_bad_pos_width $error("parameter POS_WIDTH must be in 8 .. 31"); end
 `define ENC_CHECK_PHASE_WINDOW_LOG2 if (PHASE_WINDOW_LOG2 < 8 || PHASE_WINDOW_LOG2 > 24) begin : g_bad_phase_window_log2 $error("parameter PHASE_WINDOW_LOG2 must be in 8 .. 24"); end
 `define ENC_CHECK_CLKS_PER_BIT if (CLKS_PER_BIT < 2 || CLKS_PER_BIT > 65535) begin : g_bad_clks_per_bit $error("parameter CLKS_PER_BIT must be in 2 .. 65535"); end
 `endif
+// The least byte-address width that holds CHANNELS pages of 256 bytes (the default of ADDR_W)
+`define ENC_QEI_ADDR_W(CH) (((CH) > 8) ? 12 : (((CH) > 4) ? 11 : (((CH) > 2) ? 10 : (((CH) > 1) ? 9 : (8)))))
+// One channel's register bundles (rtl/enc_qei_chan_fields.vh): reg2hw and hw2reg widths
+`define ENC_QEI_R2H_CH_W 386
+`define ENC_QEI_H2R_CH_W 474
 `endif

@@ -1,66 +1,102 @@
 // SPDX-License-Identifier: Apache-2.0
-// enc_qei -- the quadrature encoder interface peripheral behind a one-clock request/response
-// port; enc_qei_wb (Wishbone B4 classic) and enc_qei_axil (AXI4-Lite) are thin bus adapters
-// around it.
+// enc_qei -- the quadrature encoder interface peripheral, 1 .. 16 channels, behind a one-clock
+// request/response port; enc_qei_wb (Wishbone B4 classic) and enc_qei_axil (AXI4-Lite) are thin
+// bus adapters around it.
 //
-//   a_in, b_in  -> enc_conditioner_rt (CTRL.FILTER_LEN) --+
-//   z_in, probe_in -> enc_conditioner_rt (same length) ---+-> enc_qei_core (decode, count, range,
-//                                                         |   index, probe, compare)
-//                                      enc_qei_timing ----+   timebase, snapshots, period, stall
-//   req/resp <-> enc_qei_regs (generated from rtl/enc_qei.rdl) <-> reg2hw / hw2reg bundles
+//   req/resp <-> enc_qei_regs (generated from rtl/enc_qei.rdl): the global registers, and one
+//                page of registers per channel (page k: channel k; page 0 also the globals)
+//   enc_qei_timebase   one timebase for every channel (TB_PRESCALE, TIMEBASE)
+//   enc_qei_snaptrig   the global snapshot (GSNAP_CTRL, GSNAP_PERIOD): one request, the same
+//                      clock in every channel, and GSNAP_TIME
+//   enc_qei_channel    x CHANNELS: conditioners, counting core, timing unit of one encoder
 //
-// The register block meets the rest through two bundles, reg2hw and hw2reg; their fields have
-// names (r2h_<field>, h2r_<field>: rtl/enc_qei_regs_fields.vh, generated with the block).
-// Z and probe_in go through their own synchronizer and filter of the same length as A and B, so
-// the index lines up with the channels clock for clock. irq is registered: high from the clock
-// after an enabled event is pending until the clock after it is cleared or disabled.
+// The register block meets the rest through bundles: reg2hw_g / hw2reg_g for the global
+// registers (fields by name: rtl/enc_qei_regs_fields.vh) and one pair per channel. irq is the OR
+// of the channels' registered pending bits (IRQ_SUMMARY): high from the clock after an enabled
+// event is pending until the clock after it is cleared or disabled.
 // Request/response port: see enc_qei_regs (response two clocks after the request).
 //
-// Build options (defaults: the contract's full peripheral):
-//   PROFILE = 1     counting only: the timing unit (enc_qei_timing) is left out: TIMEBASE ..
-//                   STALL_TIMEOUT read 0 and ignore writes (no bus error), PROBE_TIME reads 0,
-//                   STATUS.STALLED and the STALL, SNAP_READY, PERIOD_READY and PERIOD_OVF events
-//                   stay 0; CAPS.TIMING reads 0. PROFILE = 2 (default): everything.
-//   FUNC_MASK       the count functions built, bit F for CTRL.FUNC value F (default: all). With
-//                   one bit set the function is fixed: CTRL.FUNC reads it and ignores writes, and
-//                   the decode logic of the others is left out. With several, a CTRL.FUNC value
-//                   outside the mask counts nothing.
+// Build options (defaults: one channel, the contract's full peripheral):
+//   CHANNELS   channels, each with its own encoder inputs, cmp_out bit and register page
+//   ADDR_W     byte address bits: at least 8 + ceil(log2(CHANNELS)) (the default)
+//   PROFILE    which units every channel has (CAPS.PROFILE; a unit left out reads 0, no bus error):
+//                2 full      everything
+//                1 counting  no timing unit (TIMEBASE .. STALL_TIMEOUT, PROBE_TIME read 0)
+//                3 lean      count functions, free count, index, timebase, snapshots with edge
+//                            time and deltas, QERR / GLITCH; no probe, compare, range modes,
+//                            period capture, stall or per-channel unit timer; COUNT_W >= 32
+//   FUNC_MASK  the count functions built, bit F for CTRL.FUNC value F (default: all). With one
+//              bit set the function is fixed: CTRL.FUNC reads it and ignores writes, and the
+//              decode logic of the others is left out. With several, a CTRL.FUNC value outside
+//              the mask counts nothing.
 `default_nettype none
 `include "enc_params.vh"
 
 module enc_qei #(
-    parameter integer COUNT_W    = 32,  // counter width in bits
-    parameter integer TS_W       = 32,  // timebase / timestamp width in bits
-    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only
-    parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F
+    parameter integer CHANNELS   = 1,    // encoder channels
+    parameter integer ADDR_W     = `ENC_QEI_ADDR_W(CHANNELS),  // byte address bits
+    parameter integer COUNT_W    = 32,   // counter width in bits
+    parameter integer TS_W       = 32,   // timebase / timestamp width in bits
+    parameter integer PROFILE    = 2,    // 2 full, 1 counting, 3 lean (see above)
+    parameter integer FUNC_MASK  = 511   // count functions built: bit F = CTRL.FUNC value F
 ) (
-    input  wire        clk,
-    input  wire        rst,         // synchronous, active high
-    input  wire        req_valid,   // one-clock request
-    input  wire        req_write,   // 1 = write
-    input  wire [7:0]  req_addr,    // byte address (bits 1:0 ignored)
-    input  wire [31:0] req_wdata,
-    input  wire [3:0]  req_wstrb,   // byte enables
-    output wire        resp_valid,  // two clocks after req_valid (one request at a time)
-    output wire [31:0] resp_rdata,
-    output wire        resp_err,    // unmapped offset
-    input  wire        a_in,        // encoder channel A, asynchronous
-    input  wire        b_in,        // encoder channel B, asynchronous
-    input  wire        z_in,        // index channel, asynchronous
-    input  wire        probe_in,    // external latch input, asynchronous
-    input  wire        snap_in,     // synchronous snapshot strobe
-    output wire        irq,         // any enabled pending event
-    output wire        cmp_out      // one-clock pulse on a compare match
+    input  wire                clk,
+    input  wire                rst,         // synchronous, active high
+    input  wire                req_valid,   // one-clock request
+    input  wire                req_write,   // 1 = write
+    input  wire [ADDR_W-1:0]   req_addr,    // byte address (bits 1:0 ignored)
+    input  wire [31:0]         req_wdata,
+    input  wire [3:0]          req_wstrb,   // byte enables
+    output wire                resp_valid,  // two clocks after req_valid (one request at a time)
+    output wire [31:0]         resp_rdata,
+    output wire                resp_err,    // no register at that address
+    input  wire [CHANNELS-1:0] a_in,        // encoder channel A of each channel, asynchronous
+    input  wire [CHANNELS-1:0] b_in,        // encoder channel B, asynchronous
+    input  wire [CHANNELS-1:0] z_in,        // index channel, asynchronous
+    input  wire [CHANNELS-1:0] probe_in,    // external latch input, asynchronous
+    input  wire                snap_in,     // synchronous snapshot strobe (every channel)
+    output wire                irq,         // any channel has an enabled pending event
+    output wire [CHANNELS-1:0] cmp_out      // one-clock pulse on a compare match, per channel
 );
 
   generate
+    `ENC_CHECK_CHANNELS
+    `ENC_CHECK_ADDR_W
     `ENC_CHECK_COUNT_W
     `ENC_CHECK_TS_W
     `ENC_CHECK_PROFILE
     `ENC_CHECK_FUNC_MASK
+    // (ADDR_W must hold the pages: a relation enc_ip.core's ranges cannot hold)
+    if ((1 << (ADDR_W - 8)) < CHANNELS) begin : g_bad_addr_w_pages
+`ifdef __ICARUS__
+      enc_qei__parameter_ADDR_W_must_be_at_least_8_plus_log2_CHANNELS u_stop ();
+`else
+      $error("enc_qei: parameter ADDR_W must be at least 8 + ceil(log2(CHANNELS))");
+`endif
+    end
   endgenerate
 
   `include "enc_qei_regs.vh"
+
+  // the units of each profile (the register block's features)
+  localparam integer P_FULL = {29'd0, ENC_QEI_PROFILE_FULL};
+  localparam integer P_LEAN = {29'd0, ENC_QEI_PROFILE_LEAN};
+  localparam integer P_CNT  = {29'd0, ENC_QEI_PROFILE_COUNTING};
+  localparam integer TIMING = (PROFILE == P_FULL || PROFILE == P_LEAN) ? 1 : 0;
+  localparam integer RANGE  = (PROFILE == P_FULL || PROFILE == P_CNT) ? 1 : 0;
+  localparam integer PROBE  = RANGE;
+  localparam integer PERIOD = (PROFILE == P_FULL) ? 1 : 0;
+
+  generate
+    // (the lean profile's count is a free-running 32..64-bit count)
+    if (PROFILE == P_LEAN && COUNT_W < 32) begin : g_bad_lean_count_w
+`ifdef __ICARUS__
+      enc_qei__parameter_COUNT_W_must_be_at_least_32_with_PROFILE_lean u_stop ();
+`else
+      $error("enc_qei: PROFILE lean (3) needs COUNT_W of at least 32");
+`endif
+    end
+  endgenerate
 
   // The code of the one count function FUNC_MASK builds, or -1 when it builds several.
   function integer single_func;
@@ -76,18 +112,7 @@ module enc_qei #(
     end
   endfunction
 
-  localparam integer TIMING     = (PROFILE >= 2) ? 1 : 0;
   localparam integer FIXED_FUNC = single_func(FUNC_MASK);
-  localparam integer FUNC_ALL   = (1 << ENC_QEI_FUNC_N) - 1;
-  localparam [15:0]  FUNC_MASK16 = FUNC_MASK[15:0];
-
-  function [63:0] zext_count;
-    input [COUNT_W-1:0] v;
-    begin
-      zext_count = 64'd0;
-      zext_count[COUNT_W-1:0] = v;
-    end
-  endfunction
 
   function [31:0] zext_ts;
     input [TS_W-1:0] v;
@@ -98,13 +123,20 @@ module enc_qei #(
   endfunction
 
   // ---- register block and its bundles ----------------------------------------------------------
-  wire [ENC_QEI_R2H_W-1:0] reg2hw;
-  wire [ENC_QEI_H2R_W-1:0] hw2reg;
+  wire [ENC_QEI_R2H_W-1:0]             reg2hw_g;
+  wire [ENC_QEI_H2R_W-1:0]             hw2reg_g;
+  wire [CHANNELS*ENC_QEI_R2H_CH_W-1:0] reg2hw_ch;
+  wire [CHANNELS*ENC_QEI_H2R_CH_W-1:0] hw2reg_ch;
   `include "enc_qei_regs_fields.vh"
 
   enc_qei_regs #(
       .TIMING    (TIMING),
+      .RANGE     (RANGE),
+      .PROBE     (PROBE),
+      .PERIOD    (PERIOD),
       .FIXED_FUNC(FIXED_FUNC),
+      .CHANNELS  (CHANNELS),
+      .ADDR_W    (ADDR_W),
       .COUNT_W   (COUNT_W),
       .TS_W      (TS_W)
   ) u_regs (
@@ -118,232 +150,123 @@ module enc_qei #(
       .resp_valid(resp_valid),
       .resp_rdata(resp_rdata),
       .resp_err  (resp_err),
-      .reg2hw    (reg2hw),
-      .hw2reg    (hw2reg)
+      .reg2hw_g  (reg2hw_g),
+      .hw2reg_g  (hw2reg_g),
+      .reg2hw_ch (reg2hw_ch),
+      .hw2reg_ch (hw2reg_ch)
   );
 
-  localparam [7:0] COUNT_W8 = COUNT_W[7:0];
-  localparam [7:0] TS_W8    = TS_W[7:0];
+  localparam [7:0] COUNT_W8   = COUNT_W[7:0];
+  localparam [7:0] TS_W8      = TS_W[7:0];
+  localparam [2:0] PROFILE3   = PROFILE[2:0];
+  localparam [4:0] CHANNELS5  = CHANNELS[4:0];
 
-  assign h2r_caps_count_w = COUNT_W8;
-  assign h2r_caps_ts_w    = TS_W8;
-  assign h2r_caps_index   = 1'b1;
-  assign h2r_caps_probe   = 1'b1;
-  assign h2r_caps_timing  = (TIMING != 0);
+  assign h2r_caps_count_w  = COUNT_W8;
+  assign h2r_caps_ts_w     = TS_W8;
+  assign h2r_caps_index    = 1'b1;
+  assign h2r_caps_probe    = (PROBE != 0);
+  assign h2r_caps_timing   = (TIMING != 0);
+  assign h2r_caps_profile  = PROFILE3;
+  assign h2r_caps_channels = CHANNELS5;
 
-  // ---- conditioners ------------------------------------------------------------------------------
-  wire a_c, b_c, z_c, probe_c, glitch_ab, valid_ab, glitch_zp_unused, valid_zp_unused;
-
-  enc_conditioner_rt #(
-      .MAX_FILTER_LEN(16)
-  ) u_cond_ab (
-      .clk       (clk),
-      .rst       (rst),
-      .filter_len(r2h_ctrl_filter_len),
-      .a_in      (a_in),
-      .b_in      (b_in),
-      .a         (a_c),
-      .b         (b_c),
-      .glitch    (glitch_ab),
-      .valid     (valid_ab)
-  );
-
-  enc_conditioner_rt #(
-      .MAX_FILTER_LEN(16)
-  ) u_cond_zp (
-      .clk       (clk),
-      .rst       (rst),
-      .filter_len(r2h_ctrl_filter_len),
-      .a_in      (z_in),
-      .b_in      (probe_in),
-      .a         (z_c),
-      .b         (probe_c),
-      .glitch    (glitch_zp_unused),
-      .valid     (valid_zp_unused)
-  );
-
-  assign h2r_status_valid        = valid_ab;
-  assign h2r_glitch_count_incr   = glitch_ab;
-
-  // CTRL.FUNC as the core sees it: with some functions left out, the others count nothing (a code
-  // no function has); with one (FIXED_FUNC) or all, the register block's CTRL.FUNC as it is.
-  wire [3:0] func_eff = (FIXED_FUNC >= 0 || FUNC_MASK == FUNC_ALL || FUNC_MASK16[r2h_ctrl_func]) ?
-                        r2h_ctrl_func : 4'd15;
-
-  // ---- core --------------------------------------------------------------------------------------
-  wire [COUNT_W-1:0] count_q, idx_latch, probe_latch;
-  wire [TS_W-1:0]    probe_time, timebase;
-  wire step_up, step_dn, applied_up, applied_dn, edge_any, edge_a_rise;
-  wire ev_overflow, ev_underflow, ev_index, ev_probe, ev_cmp, ev_qerr, ev_dir_change;
-
-  enc_qei_core #(
-      .COUNT_W(COUNT_W),
-      .TS_W   (TS_W)
-  ) u_core (
-      .clk          (clk),
-      .rst          (rst),
-      .a_c          (a_c),
-      .b_c          (b_c),
-      .z_c          (z_c),
-      .probe_c      (probe_c),
-      .valid        (valid_ab),
-      .en           (r2h_ctrl_en),
-      .swap_ab      (r2h_ctrl_swap_ab),
-      .inv_a        (r2h_ctrl_inv_a),
-      .inv_b        (r2h_ctrl_inv_b),
-      .inv_z        (r2h_ctrl_inv_z),
-      .func         (func_eff),
-      .range        (r2h_ctrl_range),
-      .preset       (r2h_preset[COUNT_W-1:0]),
-      .ceiling      (r2h_ceiling[COUNT_W-1:0]),
-      .compare      (r2h_compare[COUNT_W-1:0]),
-      .idx_action   (r2h_index_ctrl_action),
-      .idx_oneshot  (r2h_index_ctrl_oneshot),
-      .idx_edge     (r2h_index_ctrl_edge),
-      .idx_gate_en  (r2h_index_ctrl_gate_en),
-      .idx_gate_a   (r2h_index_ctrl_gate_a),
-      .idx_gate_b   (r2h_index_ctrl_gate_b),
-      .idx_arm      (r2h_index_ctrl_arm),
-      .probe_en     (r2h_probe_ctrl_en),
-      .probe_edge   (r2h_probe_ctrl_edge),
-      .probe_once   (r2h_probe_ctrl_once),
-      .timebase     (timebase),
-      .load         (r2h_count_load),
-      .load_value   (r2h_count_load_value[COUNT_W-1:0]),
-      .count        (count_q),
-      .idx_latch    (idx_latch),
-      .probe_latch  (probe_latch),
-      .probe_time   (probe_time),
-      .a_eff        (h2r_status_a),
-      .b_eff        (h2r_status_b),
-      .z_eff        (h2r_status_z),
-      .dir          (h2r_status_dir),
-      .idx_armed    (h2r_status_index_armed),
-      .stopped      (h2r_status_stopped),
-      .idx_disarm   (h2r_index_ctrl_arm_clr),
-      .probe_disarm (h2r_probe_ctrl_en_clr),
-      .step_up      (step_up),
-      .step_dn      (step_dn),
-      .applied_up   (applied_up),
-      .applied_dn   (applied_dn),
-      .edge_any     (edge_any),
-      .edge_a_rise  (edge_a_rise),
-      .ev_overflow  (ev_overflow),
-      .ev_underflow (ev_underflow),
-      .ev_index     (ev_index),
-      .ev_probe     (ev_probe),
-      .ev_cmp       (ev_cmp),
-      .ev_qerr      (ev_qerr),
-      .ev_dir_change(ev_dir_change),
-      .cmp_out      (cmp_out)
-  );
-
-  assign h2r_count           = zext_count(count_q);
-  assign h2r_index_latch     = zext_count(idx_latch);
-  assign h2r_probe_latch     = zext_count(probe_latch);
-  assign h2r_probe_time      = zext_ts(probe_time);
-  assign h2r_qerr_count_incr = ev_qerr;
-
-  // ---- timing: timebase, snapshots, period capture, stall --------------------------------------
-  wire ev_snap, ev_period, ev_period_ovf, ev_stall;
+  // ---- the timebase and the global snapshot: one for every channel -------------------------
+  wire [TS_W-1:0] timebase;
+  wire            tick, gsnap;
 
   generate
-    if (TIMING != 0) begin : g_timing
-      wire [COUNT_W-1:0] snap_count;
-      wire [TS_W-1:0]    snap_time, snap_edge_time, period;
+    if (TIMING != 0) begin : g_timebase
+      reg [TS_W-1:0] gsnap_time_q;
 
-      enc_qei_timing #(
-          .COUNT_W(COUNT_W),
-          .TS_W   (TS_W)
-      ) u_timing (
-          .clk            (clk),
-          .rst            (rst),
-          .prescale       (r2h_tb_prescale_prescale),
-          .edge_any       (edge_any),
-          .edge_a_rise    (edge_a_rise),
-          .step           (step_up | step_dn),
-          .applied_up     (applied_up),
-          .applied_dn     (applied_dn),
-          .dir_change     (ev_dir_change),
-          .count          (count_q),
-          .snap_cmd       (r2h_snap_ctrl_cmd),
-          .snap_in        (snap_in),
-          .snap_in_en     (r2h_snap_ctrl_in_en),
-          .snap_period_en (r2h_snap_ctrl_period_en),
-          .snap_edge      (r2h_snap_ctrl_edge),
-          .snap_period    (r2h_snap_period[TS_W-1:0]),
-          .period_en      (r2h_period_ctrl_en),
-          .period_edge    (r2h_period_ctrl_edge),
-          .period_n       (r2h_period_ctrl_n),
-          .stall_timeout  (r2h_stall_timeout[TS_W-1:0]),
-          .timebase       (timebase),
-          .snap_count     (snap_count),
-          .snap_time      (snap_time),
-          .snap_edge_time (snap_edge_time),
-          .snap_delta     (h2r_snap_delta),
-          .snap_edge_delta(h2r_snap_edge_delta),
-          .period         (period),
-          .period_ovf_flag(h2r_period_ctrl_overflow),
-          .period_dir_flag(h2r_period_ctrl_dir_change),
-          .stalled        (h2r_status_stalled),
-          .ev_snap        (ev_snap),
-          .ev_period      (ev_period),
-          .ev_period_ovf  (ev_period_ovf),
-          .ev_stall       (ev_stall)
+      enc_qei_timebase #(
+          .TS_W(TS_W)
+      ) u_timebase (
+          .clk     (clk),
+          .rst     (rst),
+          .prescale(r2h_tb_prescale_prescale),
+          .timebase(timebase),
+          .tick    (tick)
       );
 
-      assign h2r_snap_count     = zext_count(snap_count);
-      assign h2r_snap_time      = zext_ts(snap_time);
-      assign h2r_snap_edge_time = zext_ts(snap_edge_time);
-      assign h2r_period         = zext_ts(period);
-    end else begin : g_no_timing
-      wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn, applied_up, applied_dn,
-                             snap_in};
-      assign timebase                   = {TS_W{1'b0}};
-      assign h2r_snap_count             = 64'd0;
-      assign h2r_snap_time              = 32'd0;
-      assign h2r_snap_edge_time         = 32'd0;
-      assign h2r_snap_delta             = 32'd0;
-      assign h2r_snap_edge_delta        = 32'd0;
-      assign h2r_period                 = 32'd0;
-      assign h2r_period_ctrl_overflow   = 1'b0;
-      assign h2r_period_ctrl_dir_change = 1'b0;
-      assign h2r_status_stalled         = 1'b0;
-      assign ev_snap                    = 1'b0;
-      assign ev_period                  = 1'b0;
-      assign ev_period_ovf              = 1'b0;
-      assign ev_stall                   = 1'b0;
+      enc_qei_snaptrig #(
+          .TS_W (TS_W),
+          .TIMER(1)
+      ) u_gsnap (
+          .clk      (clk),
+          .rst      (rst),
+          .tick     (tick),
+          .cmd      (r2h_gsnap_ctrl_cmd),
+          .snap_in  (snap_in),
+          .in_en    (r2h_gsnap_ctrl_in_en),
+          .period_en(r2h_gsnap_ctrl_period_en),
+          .period   (r2h_gsnap_period[TS_W-1:0]),
+          .req      (gsnap)
+      );
+
+      always @(posedge clk) begin
+        if (rst) begin
+          gsnap_time_q <= {TS_W{1'b0}};
+        end else if (gsnap) begin
+          gsnap_time_q <= timebase;
+        end
+      end
+
+      assign h2r_gsnap_time = zext_ts(gsnap_time_q);
+    end else begin : g_no_timebase
+      assign timebase       = {TS_W{1'b0}};
+      assign tick           = 1'b0;
+      assign gsnap          = 1'b0;
+      assign h2r_gsnap_time = 32'd0;
     end
   endgenerate
 
   assign h2r_timebase = zext_ts(timebase);
 
-  // ---- events and interrupt ------------------------------------------------------------------------
-  // EVENTS bits by their names in the map: each event's one-clock set strobe
-  assign h2r_events_set[ENC_QEI_EVENTS_OVERFLOW]     = ev_overflow;
-  assign h2r_events_set[ENC_QEI_EVENTS_UNDERFLOW]    = ev_underflow;
-  assign h2r_events_set[ENC_QEI_EVENTS_INDEX]        = ev_index;
-  assign h2r_events_set[ENC_QEI_EVENTS_PROBE]        = ev_probe;
-  assign h2r_events_set[ENC_QEI_EVENTS_CMP]          = ev_cmp;
-  assign h2r_events_set[ENC_QEI_EVENTS_QERR]         = ev_qerr;
-  assign h2r_events_set[ENC_QEI_EVENTS_GLITCH]       = glitch_ab;
-  assign h2r_events_set[ENC_QEI_EVENTS_DIR_CHANGE]   = ev_dir_change;
-  assign h2r_events_set[ENC_QEI_EVENTS_STALL]        = ev_stall;
-  assign h2r_events_set[ENC_QEI_EVENTS_SNAP_READY]   = ev_snap;
-  assign h2r_events_set[ENC_QEI_EVENTS_PERIOD_READY] = ev_period;
-  assign h2r_events_set[ENC_QEI_EVENTS_PERIOD_OVF]   = ev_period_ovf;
+  // ---- the channels ----------------------------------------------------------------------------------
+  wire [CHANNELS-1:0] irq_pend;
 
-  reg irq_q;
+  genvar ch;
+  generate
+    for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
+      enc_qei_channel #(
+          .COUNT_W  (COUNT_W),
+          .TS_W     (TS_W),
+          .FUNC_MASK(FUNC_MASK),
+          .TIMING   (TIMING),
+          .RANGE    (RANGE),
+          .PROBE    (PROBE),
+          .PERIOD   (PERIOD)
+      ) u_chan (
+          .clk     (clk),
+          .rst     (rst),
+          .reg2hw  (reg2hw_ch[ch*ENC_QEI_R2H_CH_W +: ENC_QEI_R2H_CH_W]),
+          .hw2reg  (hw2reg_ch[ch*ENC_QEI_H2R_CH_W +: ENC_QEI_H2R_CH_W]),
+          .a_in    (a_in[ch]),
+          .b_in    (b_in[ch]),
+          .z_in    (z_in[ch]),
+          .probe_in(probe_in[ch]),
+          .snap_in (snap_in),
+          .timebase(timebase),
+          .tick    (tick),
+          .gsnap   (gsnap),
+          .cmp_out (cmp_out[ch]),
+          .irq_pend(irq_pend[ch])
+      );
+    end
+  endgenerate
 
-  always @(posedge clk) begin
-    if (rst) begin
-      irq_q <= 1'b0;
-    end else begin
-      irq_q <= |(r2h_events & r2h_irq_en_en);
+  // ---- interrupt summary --------------------------------------------------------------------------
+  reg [15:0] pending;  // irq_pend, bit k for channel k
+  integer    k;
+
+  always @(*) begin
+    pending = 16'd0;
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      pending[k] = irq_pend[k];
     end
   end
 
-  assign irq = irq_q;
+  assign h2r_irq_summary_pending = pending;
+  assign irq = |irq_pend;
 
 endmodule
 

@@ -12,15 +12,17 @@
 `include "enc_params.vh"
 
 module enc_qei_axil #(
-    parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
-    parameter integer TS_W       = 32,  // timebase / timestamp width: 16 .. 32
-    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only (see enc_qei)
+    parameter integer CHANNELS   = 1,   // encoder channels (see enc_qei)
+    parameter integer ADDR_W     = `ENC_QEI_ADDR_W(CHANNELS),  // byte address bits (see enc_qei)
+    parameter integer COUNT_W    = 32,  // counter width in bits
+    parameter integer TS_W       = 32,  // timebase / timestamp width in bits
+    parameter integer PROFILE    = 2,   // 2 full, 1 counting, 3 lean (see enc_qei)
     parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,            // synchronous, active high
     // AXI4-Lite slave
-    input  wire [7:0]  s_axil_awaddr,  // byte address (bits 1:0 ignored)
+    input  wire [ADDR_W-1:0] s_axil_awaddr,  // byte address (bits 1:0 ignored)
     // verilator lint_off UNUSEDSIGNAL
     input  wire [2:0]  s_axil_awprot,  // ignored
     // verilator lint_on UNUSEDSIGNAL
@@ -33,7 +35,7 @@ module enc_qei_axil #(
     output wire [1:0]  s_axil_bresp,
     output wire        s_axil_bvalid,
     input  wire        s_axil_bready,
-    input  wire [7:0]  s_axil_araddr,  // byte address (bits 1:0 ignored)
+    input  wire [ADDR_W-1:0] s_axil_araddr,  // byte address (bits 1:0 ignored)
     // verilator lint_off UNUSEDSIGNAL
     input  wire [2:0]  s_axil_arprot,  // ignored
     // verilator lint_on UNUSEDSIGNAL
@@ -44,16 +46,18 @@ module enc_qei_axil #(
     output wire        s_axil_rvalid,
     input  wire        s_axil_rready,
     // encoder and system
-    input  wire        a_in,           // encoder channel A, asynchronous
-    input  wire        b_in,           // encoder channel B, asynchronous
-    input  wire        z_in,           // index channel, asynchronous
-    input  wire        probe_in,       // external latch input, asynchronous
+    input  wire [CHANNELS-1:0] a_in,     // encoder channel A, asynchronous
+    input  wire [CHANNELS-1:0] b_in,     // encoder channel B, asynchronous
+    input  wire [CHANNELS-1:0] z_in,     // index channel, asynchronous
+    input  wire [CHANNELS-1:0] probe_in, // external latch input, asynchronous
     input  wire        snap_in,        // synchronous snapshot strobe
     output wire        irq,            // level: any enabled pending event
-    output wire        cmp_out         // one-clock pulse on a compare match
+    output wire [CHANNELS-1:0] cmp_out   // one-clock pulse on a compare match
 );
 
   generate
+    `ENC_CHECK_CHANNELS
+    `ENC_CHECK_ADDR_W
     `ENC_CHECK_COUNT_W
     `ENC_CHECK_TS_W
     `ENC_CHECK_PROFILE
@@ -62,12 +66,12 @@ module enc_qei_axil #(
 
   // ---- channel registers -------------------------------------------------------------------------
   reg        aw_v_q, w_v_q, ar_v_q;  // an address / data beat is held
-  reg [7:0]  awaddr_q, araddr_q;
+  reg [ADDR_W-1:0] awaddr_q, araddr_q;
   reg [31:0] wdata_q;
   reg [3:0]  wstrb_q;
   reg        req_q;                  // the request to enc_qei (this clock)
   reg        req_wr_q;               // ... a write
-  reg [7:0]  req_addr_q;             // ... its address
+  reg [ADDR_W-1:0] req_addr_q;       // ... its address
   reg        pend_q;                 // a request is issued and its response has not come
   reg        pend_wr_q;              // ... and it is a write
   reg        last_rd_q;              // the last request issued was a read (alternation)
@@ -88,13 +92,13 @@ module enc_qei_axil #(
       aw_v_q    <= 1'b0;
       w_v_q     <= 1'b0;
       ar_v_q    <= 1'b0;
-      awaddr_q  <= 8'd0;
-      araddr_q  <= 8'd0;
+      awaddr_q  <= {ADDR_W{1'b0}};
+      araddr_q  <= {ADDR_W{1'b0}};
       wdata_q   <= 32'd0;
       wstrb_q   <= 4'd0;
       req_q     <= 1'b0;
       req_wr_q  <= 1'b0;
-      req_addr_q <= 8'd0;
+      req_addr_q <= {ADDR_W{1'b0}};
       pend_q    <= 1'b0;
       pend_wr_q <= 1'b0;
       last_rd_q <= 1'b0;
@@ -150,6 +154,8 @@ module enc_qei_axil #(
   end
 
   enc_qei #(
+      .CHANNELS  (CHANNELS),
+      .ADDR_W    (ADDR_W),
       .COUNT_W   (COUNT_W),
       .TS_W      (TS_W),
       .PROFILE   (PROFILE),

@@ -22,11 +22,16 @@
 // count two clocks after its strobe (its value as of the strobe), and an index preset loads
 // PRESET as it was one clock earlier. A bus access takes longer than these delays: software
 // cannot tell. CTRL.EN gates count steps only: loads and index presets act whatever EN is.
+// RANGE = 0 (the lean channel) leaves the ranges out: the count is free (range, ceiling unused),
+// with no range flags, comparators or compare (cmp never fires, stopped stays 0); PROBE = 0
+// leaves the probe latch out (probe inputs unused, its outputs 0).
 `default_nettype none
 
 module enc_qei_core #(
-    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)
-    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)
+    parameter integer COUNT_W = 32,  // counter width (checked by enc_qei)
+    parameter integer TS_W    = 32,  // timebase width (checked by enc_qei)
+    parameter integer RANGE   = 1,   // 1: ranges (CEILING) and compare; 0: free count, no compare
+    parameter integer PROBE   = 1    // 1: the probe latch; 0: without it
 ) (
     input  wire               clk,
     input  wire               rst,            // synchronous, active high
@@ -258,7 +263,7 @@ module enc_qei_core #(
   reg       idx_oneshot_q;
 
   always @(posedge clk) begin
-    range_q       <= range;
+    range_q       <= (RANGE != 0) ? range : ENC_QEI_RANGE_FREE;
     idx_arm_q     <= idx_arm;
     idx_action_q  <= idx_action;
     idx_oneshot_q <= idx_oneshot;
@@ -321,33 +326,6 @@ module enc_qei_core #(
     end
   endfunction
 
-  // ---- CEILING pipeline (Fmax) ----------------------------------------------------------------------
-  // The count uses CEILING as it was two clocks earlier (ceil_q), so that (count >= CEILING) can
-  // be flag registers (up_wrap_q, up_lim_q, up_blk_q below), set like zero_q from the next count's
-  // candidates, each compared with the next clock's ceiling N (kept inverted, as N - 1 and N - 2
-  // as well, for gt_n) by a comparator between registers.
-  // Not reset: a pure delay of the CEILING register.
-  reg [COUNT_W-1:0] ceil_nx_n_q;     // ~N, N = CEILING one clock ago: the ceiling of the next clock
-  reg [COUNT_W-1:0] ceil_nx_m1n_q;   // ~(N - 1)
-  reg [COUNT_W-1:0] ceil_nx_m2n_q;   // ~(N - 2)
-  reg               ceil_nx_zero_q;  // N == 0
-  reg               ceil_nx_le1_q;   // N <= 1
-  reg [COUNT_W-1:0] ceil_q;          // CEILING two clocks ago: the ceiling the count uses now
-  reg               ceil_zero_q;     // ... is 0
-  reg               ceil_wrap_ge_q;  // ceil_q >= N (a modulo wrap down to ceil_q)
-  wire [COUNT_W-1:0] ceil_nx = ~ceil_nx_n_q;
-
-  always @(posedge clk) begin
-    ceil_nx_n_q    <= ~ceiling;
-    ceil_nx_m1n_q  <= ~(ceiling - {{(COUNT_W-1){1'b0}}, 1'b1});
-    ceil_nx_m2n_q  <= ~(ceiling - {{(COUNT_W-2){1'b0}}, 2'd2});
-    ceil_nx_zero_q <= (ceiling == {COUNT_W{1'b0}});
-    ceil_nx_le1_q  <= (ceiling[COUNT_W-1:1] == {(COUNT_W-1){1'b0}});
-    ceil_q         <= ceil_nx;
-    ceil_zero_q    <= ceil_nx_zero_q;
-    ceil_wrap_ge_q <= ge_w(ceil_nx, ceiling);
-  end
-
   // ---- index ---------------------------------------------------------------------------------------
   // Qualified index: Z and, with the gate, (A, B) = (GATE_A, GATE_B); the chosen edge of it acts.
   wire idx_q      = z_eff & (~idx_gate_en | ((a_eff == idx_gate_a) & (b_eff == idx_gate_b)));
@@ -404,9 +382,13 @@ module enc_qei_core #(
   always @(posedge clk) begin
     wr_val_q    <= load_value;
     load_val_q  <= wr_pend_q ? wr_val_q : preset;
-    load_ge_q   <= wr_pend_q ? ge_w(wr_val_q, ceiling) : ge_w(preset, ceiling);
+    load_ge_q   <= (RANGE != 0) & (wr_pend_q ? ge_w(wr_val_q, ceiling) : ge_w(preset, ceiling));
     load_zero_q <= wr_pend_q ? (wr_val_q == {COUNT_W{1'b0}}) : (preset == {COUNT_W{1'b0}});
   end
+
+  // the ceiling as the count uses it now (RANGE; see the CEILING pipeline below)
+  wire [COUNT_W-1:0] ceil_now;
+  wire               ceil_now_zero;
 
   // ---- range decisions: flag registers (Fmax) ------------------------------------------------------
   // What an up / down step does this clock, decided from the flags of the clock before (each set
@@ -416,11 +398,11 @@ module enc_qei_core #(
   //         stop_q     non_recycle stopped: no step           (the same stop_q)
   //         up_blk     = up_wrap | up_lim | stop_q            dn_blk_q = dn_wrap_q | dn_lim_q | stop_q
   // A free range blocks nothing (the count wraps by itself; overflow / underflow at the ends).
-  reg [1:0] up_wrap_q, up_lim_q, up_blk_q;  // (each: partial flags, see parts() below)
-  reg       dn_wrap_q, dn_lim_q, dn_blk_q, stop_q;
-  wire      up_wrap = |up_wrap_q;
-  wire      up_lim  = |up_lim_q;
-  wire      up_blk  = stop_q | (|up_blk_q);
+  wire [1:0] up_wrap_q, up_lim_q, up_blk_q;  // (each: partial flags, see parts() below)
+  wire       dn_wrap_q, dn_lim_q, dn_blk_q, stop_q;
+  wire       up_wrap = |up_wrap_q;
+  wire       up_lim  = |up_lim_q;
+  wire       up_blk  = stop_q | (|up_blk_q);
 
   // The cases of this clock (step_up and step_dn never come together: every count function gives
   // one or the other, formal/enc_qei_core.sby asserts it):
@@ -473,7 +455,7 @@ module enc_qei_core #(
   // the count after this clock's step, before the loads: the adder's, or else (early signals)
   // the ceiling, 0 or the count itself
   (* keep *) wire [COUNT_W-1:0] stepped_other;
-  assign stepped_other = ({COUNT_W{k_ceil}} & ceil_q) | ({COUNT_W{~k_ceil & ~k_zero}} & count_q);
+  assign stepped_other = ({COUNT_W{k_ceil}} & ceil_now) | ({COUNT_W{~k_ceil & ~k_zero}} & count_q);
   wire [COUNT_W-1:0] stepped = k_move ? count_step : stepped_other;
 
   // The next count: the adder's, or else a load or stepped_other (early signals; keep: the late
@@ -494,58 +476,119 @@ module enc_qei_core #(
                    {1'b0, load_q, s_hold, s_inc & ~at_max, s_inc & at_max, s_dec, s_zero, s_ceil};
   // zero: count_d == 0
   wire is_one = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
-  wire [7:0] z_cand = {1'b1, load_zero_q, zero_q, 1'b0, 1'b1, is_one, 1'b1, ceil_zero_q};
-  // at CEILING: count_d >= N, N the next clock's ceiling (ceil_nx); N = 0: every count is >= N.
-  // count_q - 1 from 0 is the maximum, >= every N. (keep: each comparator's candidate is one LUT
-  // after its carry chains, and its flag one LUT later)
-  (* keep *) wire cand_hold;  // count_q >= N
-  assign cand_hold = ceil_nx_zero_q | gt_n(count_q, ceil_nx_m1n_q);
-  (* keep *) wire cand_inc;   // count_q + 1 >= N (no wrap)
-  assign cand_inc = ceil_nx_le1_q | gt_n(count_q, ceil_nx_m2n_q);
-  (* keep *) wire cand_dec;   // count_q - 1 >= N (count_q > 0), or the maximum (count_q = 0)
-  assign cand_dec = at_zero | gt_n(count_q, ceil_nx_n_q);
-  wire [7:0] c_cand = {ceil_nx_zero_q, load_ge_q, cand_hold, cand_inc, ceil_nx_zero_q, cand_dec,
-                       ceil_nx_zero_q, ceil_wrap_ge_q};
-  // The range gates the selects (early), not the flags (late). The at-CEILING flags are each
-  // kept as two partial registers (their OR is the flag), so that a comparator's carry chains
-  // feed two LUT levels only, the candidate and its flag: (Fmax)
-  //   [0] hold | +1 (the late ones)   [1] -1 (late) | the rest (early)
-  function [1:0] parts;
-    input [2:0] late;   // the gated selects of hold, +1 and -1
-    input       early;  // the OR of the early cases' terms
-    begin
-      parts[0] = (late[2] & cand_hold) | (late[1] & cand_inc);
-      parts[1] = (late[0] & cand_dec) | early;
-    end
-  endfunction
-
-  wire       stop_n  = ~rst & (range == ENC_QEI_RANGE_NON_RECYCLE) & stopped_d;
-  wire [7:0] sel_mod = sel & {8{range == ENC_QEI_RANGE_MODULO}};                            // next: modulo
-  wire [7:0] sel_lim = sel & {8{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
-  wire [7:0] sel_bnd = sel & {8{range != ENC_QEI_RANGE_FREE}};                              // bounded
-  // (keep: the late candidates' selects are nets, so that each partial flag is one LUT)
-  (* keep *) wire [2:0] late_mod;
-  assign late_mod = {sel_mod[5], sel_mod[4], sel_mod[2]};
-  (* keep *) wire [2:0] late_lim;
-  assign late_lim = {sel_lim[5], sel_lim[4], sel_lim[2]};
-  (* keep *) wire [2:0] late_bnd;
-  assign late_bnd = {sel_bnd[5], sel_bnd[4], sel_bnd[2]};
-  // (keep: the early cases' terms are ORed apart from the late ones, for the same reason)
-  localparam [7:0] EARLY = 8'b1100_1011;  // rst, load, +1 wrapping, ->0, ->CEILING
-  (* keep *) wire [2:0] early_g;           // {modulo, limit, bounded}
-  assign early_g = {|(sel_mod & c_cand & EARLY), |(sel_lim & c_cand & EARLY),
-                    |(sel_bnd & c_cand & EARLY)};
-
+  wire [7:0] z_cand = {1'b1, load_zero_q, zero_q, 1'b0, 1'b1, is_one, 1'b1, ceil_now_zero};
+  // zero: the next count is 0 (every range)
   always @(posedge clk) begin
-    zero_q    <= |(sel & z_cand);
-    up_wrap_q <= parts(late_mod, early_g[2]);
-    up_lim_q  <= parts(late_lim, early_g[1]);
-    up_blk_q  <= parts(late_bnd, early_g[0]);
-    dn_wrap_q <= |(sel_mod & z_cand);
-    dn_lim_q  <= |(sel_lim & z_cand);
-    dn_blk_q  <= stop_n | (|(sel_bnd & z_cand));
-    stop_q    <= stop_n;
+    zero_q <= |(sel & z_cand);
   end
+
+  generate
+    if (RANGE != 0) begin : g_range
+      // ---- CEILING pipeline (Fmax) ----------------------------------------------------------------------
+      // The count uses CEILING as it was two clocks earlier (ceil_q), so that (count >= CEILING) can
+      // be flag registers (up_wrap_q, up_lim_q, up_blk_q below), set like zero_q from the next count's
+      // candidates, each compared with the next clock's ceiling N (kept inverted, as N - 1 and N - 2
+      // as well, for gt_n) by a comparator between registers.
+      // Not reset: a pure delay of the CEILING register.
+      reg [COUNT_W-1:0] ceil_nx_n_q;     // ~N, N = CEILING one clock ago: the ceiling of the next clock
+      reg [COUNT_W-1:0] ceil_nx_m1n_q;   // ~(N - 1)
+      reg [COUNT_W-1:0] ceil_nx_m2n_q;   // ~(N - 2)
+      reg               ceil_nx_zero_q;  // N == 0
+      reg               ceil_nx_le1_q;   // N <= 1
+      reg [COUNT_W-1:0] ceil_q;          // CEILING two clocks ago: the ceiling the count uses now
+      reg               ceil_zero_q;     // ... is 0
+      reg               ceil_wrap_ge_q;  // ceil_q >= N (a modulo wrap down to ceil_q)
+      wire [COUNT_W-1:0] ceil_nx = ~ceil_nx_n_q;
+
+      always @(posedge clk) begin
+        ceil_nx_n_q    <= ~ceiling;
+        ceil_nx_m1n_q  <= ~(ceiling - {{(COUNT_W-1){1'b0}}, 1'b1});
+        ceil_nx_m2n_q  <= ~(ceiling - {{(COUNT_W-2){1'b0}}, 2'd2});
+        ceil_nx_zero_q <= (ceiling == {COUNT_W{1'b0}});
+        ceil_nx_le1_q  <= (ceiling[COUNT_W-1:1] == {(COUNT_W-1){1'b0}});
+        ceil_q         <= ceil_nx;
+        ceil_zero_q    <= ceil_nx_zero_q;
+        ceil_wrap_ge_q <= ge_w(ceil_nx, ceiling);
+      end
+
+      assign ceil_now      = ceil_q;
+      assign ceil_now_zero = ceil_zero_q;
+
+      // at CEILING: count_d >= N, N the next clock's ceiling (ceil_nx); N = 0: every count is >= N.
+      // count_q - 1 from 0 is the maximum, >= every N. (keep: each comparator's candidate is one LUT
+      // after its carry chains, and its flag one LUT later)
+      (* keep *) wire cand_hold;  // count_q >= N
+      assign cand_hold = ceil_nx_zero_q | gt_n(count_q, ceil_nx_m1n_q);
+      (* keep *) wire cand_inc;   // count_q + 1 >= N (no wrap)
+      assign cand_inc = ceil_nx_le1_q | gt_n(count_q, ceil_nx_m2n_q);
+      (* keep *) wire cand_dec;   // count_q - 1 >= N (count_q > 0), or the maximum (count_q = 0)
+      assign cand_dec = at_zero | gt_n(count_q, ceil_nx_n_q);
+      wire [7:0] c_cand = {ceil_nx_zero_q, load_ge_q, cand_hold, cand_inc, ceil_nx_zero_q, cand_dec,
+                           ceil_nx_zero_q, ceil_wrap_ge_q};
+      // The range gates the selects (early), not the flags (late). The at-CEILING flags are each
+      // kept as two partial registers (their OR is the flag), so that a comparator's carry chains
+      // feed two LUT levels only, the candidate and its flag: (Fmax)
+      //   [0] hold | +1 (the late ones)   [1] -1 (late) | the rest (early)
+      function [1:0] parts;
+        input [2:0] late;   // the gated selects of hold, +1 and -1
+        input       early;  // the OR of the early cases' terms
+        begin
+          parts[0] = (late[2] & cand_hold) | (late[1] & cand_inc);
+          parts[1] = (late[0] & cand_dec) | early;
+        end
+      endfunction
+
+      wire       stop_n  = ~rst & (range == ENC_QEI_RANGE_NON_RECYCLE) & stopped_d;
+      wire [7:0] sel_mod = sel & {8{range == ENC_QEI_RANGE_MODULO}};                            // next: modulo
+      wire [7:0] sel_lim = sel & {8{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
+      wire [7:0] sel_bnd = sel & {8{range != ENC_QEI_RANGE_FREE}};                              // bounded
+      // (keep: the late candidates' selects are nets, so that each partial flag is one LUT)
+      (* keep *) wire [2:0] late_mod;
+      assign late_mod = {sel_mod[5], sel_mod[4], sel_mod[2]};
+      (* keep *) wire [2:0] late_lim;
+      assign late_lim = {sel_lim[5], sel_lim[4], sel_lim[2]};
+      (* keep *) wire [2:0] late_bnd;
+      assign late_bnd = {sel_bnd[5], sel_bnd[4], sel_bnd[2]};
+      // (keep: the early cases' terms are ORed apart from the late ones, for the same reason)
+      localparam [7:0] EARLY = 8'b1100_1011;  // rst, load, +1 wrapping, ->0, ->CEILING
+      (* keep *) wire [2:0] early_g;           // {modulo, limit, bounded}
+      assign early_g = {|(sel_mod & c_cand & EARLY), |(sel_lim & c_cand & EARLY),
+                        |(sel_bnd & c_cand & EARLY)};
+
+      reg [1:0] up_wrap_r, up_lim_r, up_blk_r;
+      reg       dn_wrap_r, dn_lim_r, dn_blk_r, stop_r;
+
+      always @(posedge clk) begin
+        up_wrap_r <= parts(late_mod, early_g[2]);
+        up_lim_r  <= parts(late_lim, early_g[1]);
+        up_blk_r  <= parts(late_bnd, early_g[0]);
+        dn_wrap_r <= |(sel_mod & z_cand);
+        dn_lim_r  <= |(sel_lim & z_cand);
+        dn_blk_r  <= stop_n | (|(sel_bnd & z_cand));
+        stop_r    <= stop_n;
+      end
+
+      assign up_wrap_q = up_wrap_r;
+      assign up_lim_q  = up_lim_r;
+      assign up_blk_q  = up_blk_r;
+      assign dn_wrap_q = dn_wrap_r;
+      assign dn_lim_q  = dn_lim_r;
+      assign dn_blk_q  = dn_blk_r;
+      assign stop_q    = stop_r;
+    end else begin : g_free
+      // the free range: nothing wraps early, stops or blocks (overflow / underflow at the ends)
+      wire unused_range = &{1'b0, ceiling, load_ge_q, rst};
+      assign ceil_now      = {COUNT_W{1'b0}};
+      assign ceil_now_zero = 1'b0;
+      assign up_wrap_q     = 2'd0;
+      assign up_lim_q      = 2'd0;
+      assign up_blk_q      = 2'd0;
+      assign dn_wrap_q     = 1'b0;
+      assign dn_lim_q      = 1'b0;
+      assign dn_blk_q      = 1'b0;
+      assign stop_q        = 1'b0;
+    end
+  endgenerate
 
   reg upd_q;  // the count changed (step or load) at the last clock edge
 
@@ -588,7 +631,7 @@ module enc_qei_core #(
     end else begin
       probe_prev_q <= probe_c;
       probe_ok_q   <= 1'b1;
-      probe_hit_q  <= probe_ok_q & probe_en &
+      probe_hit_q  <= (PROBE != 0) & probe_ok_q & probe_en &
                       (probe_edge ? (probe_prev_q & ~probe_c) : (~probe_prev_q & probe_c));
     end
   end
@@ -616,7 +659,7 @@ module enc_qei_core #(
     if (rst) begin
       cmp_q <= 1'b0;
     end else begin
-      cmp_q <= upd_q & (count_q == compare);
+      cmp_q <= (RANGE != 0) & upd_q & (count_q == compare);
     end
   end
 
@@ -646,24 +689,14 @@ module enc_qei_core #(
   initial count_q = {COUNT_W{1'b0}};
   initial zero_q = 1'b1;
   always @(*) assert (zero_q == (count_q == {COUNT_W{1'b0}}));
-  // ... and the CEILING pipeline's flags agree with its values (initial values: CEILING 0)
-  initial ceil_nx_n_q = {COUNT_W{1'b1}};
-  initial ceil_nx_m1n_q = {COUNT_W{1'b0}};
-  initial ceil_nx_m2n_q = {{(COUNT_W-1){1'b0}}, 1'b1};
-  initial ceil_nx_le1_q = 1'b1;
-  initial ceil_nx_zero_q = 1'b1;
-  initial ceil_q = {COUNT_W{1'b0}};
-  initial ceil_zero_q = 1'b1;
-  initial ceil_wrap_ge_q = 1'b1;
+  // ... the registered loads and configuration (initial: free range, not stopped, no index hit)
   initial wr_q = 1'b0;
   initial wr_pend_q = 1'b0;
   initial wr_val_q = {COUNT_W{1'b0}};
   initial load_q = 1'b0;
   initial load_val_q = {COUNT_W{1'b0}};
-  initial load_ge_q = 1'b1;
+  initial load_ge_q = (RANGE != 0);
   initial load_zero_q = 1'b1;
-  // ... the configuration delay and the range / index flags (initial: free range, not stopped,
-  // no index hit)
   initial range_q = ENC_QEI_RANGE_FREE;
   initial idx_arm_q = 1'b0;
   initial idx_action_q = 2'd0;
@@ -671,36 +704,55 @@ module enc_qei_core #(
   initial stopped_q = 1'b0;
   initial idx_hit_q = 1'b0;
   initial lat_hit_q = 1'b0;
-  initial up_wrap_q = 2'd0;
-  initial up_lim_q = 2'd0;
-  initial up_blk_q = 2'd0;
-  initial dn_wrap_q = 1'b0;
-  initial dn_lim_q = 1'b0;
-  initial dn_blk_q = 1'b0;
-  initial stop_q = 1'b0;
   initial step_dn_q = 1'b0;
   initial step_dn_add_q = 1'b0;
-  wire f_at_ceil = (count_q >= ceil_q);
   always @(*) begin
-    assert (ceil_nx_m1n_q == ~(ceil_nx - {{(COUNT_W-1){1'b0}}, 1'b1}));
-    assert (ceil_nx_m2n_q == ~(ceil_nx - {{(COUNT_W-2){1'b0}}, 2'd2}));
-    assert (ceil_nx_zero_q == (ceil_nx == {COUNT_W{1'b0}}));
-    assert (ceil_nx_le1_q == (ceil_nx <= {{(COUNT_W-1){1'b0}}, 1'b1}));
-    assert (ceil_zero_q == (ceil_q == {COUNT_W{1'b0}}));
-    assert (ceil_wrap_ge_q == (ceil_q >= ceil_nx));
-    assert (load_ge_q == (load_val_q >= ceil_nx));
     assert (load_zero_q == (load_val_q == {COUNT_W{1'b0}}));
     assert (step_dn_add_q == step_dn_q);
     assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_PRESET))));
     assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_LATCH)));
-    assert (stop_q == (r_nr & stopped_q));
-    assert (up_wrap == ((range_q == ENC_QEI_RANGE_MODULO) & f_at_ceil));
-    assert (up_lim == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & f_at_ceil));
-    assert (up_blk == (stop_q | (~r_free & f_at_ceil)));
-    assert (dn_wrap_q == ((range_q == ENC_QEI_RANGE_MODULO) & zero_q));
-    assert (dn_lim_q == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & zero_q));
-    assert (dn_blk_q == (stop_q | (~r_free & zero_q)));
+    if (RANGE == 0) assert (range_q == ENC_QEI_RANGE_FREE && !stopped_q && !load_ge_q);
   end
+
+  // ... and with the ranges, the CEILING pipeline's flags agree with its values (initial values:
+  // CEILING 0) and the range flags with the range, the count and the ceiling
+  generate
+    if (RANGE != 0) begin : g_range_invariants
+      initial g_range.ceil_nx_n_q = {COUNT_W{1'b1}};
+      initial g_range.ceil_nx_m1n_q = {COUNT_W{1'b0}};
+      initial g_range.ceil_nx_m2n_q = {{(COUNT_W-1){1'b0}}, 1'b1};
+      initial g_range.ceil_nx_le1_q = 1'b1;
+      initial g_range.ceil_nx_zero_q = 1'b1;
+      initial g_range.ceil_q = {COUNT_W{1'b0}};
+      initial g_range.ceil_zero_q = 1'b1;
+      initial g_range.ceil_wrap_ge_q = 1'b1;
+      initial g_range.up_wrap_r = 2'd0;
+      initial g_range.up_lim_r = 2'd0;
+      initial g_range.up_blk_r = 2'd0;
+      initial g_range.dn_wrap_r = 1'b0;
+      initial g_range.dn_lim_r = 1'b0;
+      initial g_range.dn_blk_r = 1'b0;
+      initial g_range.stop_r = 1'b0;
+      wire [COUNT_W-1:0] f_nx = g_range.ceil_nx;
+      wire f_at_ceil = (count_q >= ceil_now);
+      always @(*) begin
+        assert (g_range.ceil_nx_m1n_q == ~(f_nx - {{(COUNT_W-1){1'b0}}, 1'b1}));
+        assert (g_range.ceil_nx_m2n_q == ~(f_nx - {{(COUNT_W-2){1'b0}}, 2'd2}));
+        assert (g_range.ceil_nx_zero_q == (f_nx == {COUNT_W{1'b0}}));
+        assert (g_range.ceil_nx_le1_q == (f_nx <= {{(COUNT_W-1){1'b0}}, 1'b1}));
+        assert (ceil_now_zero == (ceil_now == {COUNT_W{1'b0}}));
+        assert (g_range.ceil_wrap_ge_q == (ceil_now >= f_nx));
+        assert (load_ge_q == (load_val_q >= f_nx));
+        assert (stop_q == (r_nr & stopped_q));
+        assert (up_wrap == ((range_q == ENC_QEI_RANGE_MODULO) & f_at_ceil));
+        assert (up_lim == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & f_at_ceil));
+        assert (up_blk == (stop_q | (~r_free & f_at_ceil)));
+        assert (dn_wrap_q == ((range_q == ENC_QEI_RANGE_MODULO) & zero_q));
+        assert (dn_lim_q == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & zero_q));
+        assert (dn_blk_q == (stop_q | (~r_free & zero_q)));
+      end
+    end
+  endgenerate
 `endif
 
 endmodule

@@ -4,43 +4,51 @@
 //   `include "enc_qei_regs.vh"
 // verilator lint_off UNUSEDPARAM
 
-// Register byte offsets
-localparam [7:0] ENC_QEI_ID = 8'h00;
-localparam [7:0] ENC_QEI_CAPS = 8'h04;
-localparam [7:0] ENC_QEI_CTRL = 8'h08;
-localparam [7:0] ENC_QEI_STATUS = 8'h0C;
-localparam [7:0] ENC_QEI_COUNT_LO = 8'h10;
-localparam [7:0] ENC_QEI_COUNT_HI = 8'h14;
-localparam [7:0] ENC_QEI_PRESET_LO = 8'h18;
-localparam [7:0] ENC_QEI_PRESET_HI = 8'h1C;
-localparam [7:0] ENC_QEI_CEILING_LO = 8'h20;
-localparam [7:0] ENC_QEI_CEILING_HI = 8'h24;
-localparam [7:0] ENC_QEI_COMPARE_LO = 8'h28;
-localparam [7:0] ENC_QEI_COMPARE_HI = 8'h2C;
-localparam [7:0] ENC_QEI_INDEX_CTRL = 8'h30;
-localparam [7:0] ENC_QEI_INDEX_LATCH_LO = 8'h34;
-localparam [7:0] ENC_QEI_INDEX_LATCH_HI = 8'h38;
-localparam [7:0] ENC_QEI_PROBE_CTRL = 8'h3C;
-localparam [7:0] ENC_QEI_PROBE_LATCH_LO = 8'h40;
-localparam [7:0] ENC_QEI_PROBE_LATCH_HI = 8'h44;
-localparam [7:0] ENC_QEI_PROBE_TIME = 8'h48;
-localparam [7:0] ENC_QEI_EVENTS = 8'h4C;
-localparam [7:0] ENC_QEI_IRQ_EN = 8'h50;
-localparam [7:0] ENC_QEI_QERR_COUNT = 8'h54;
-localparam [7:0] ENC_QEI_GLITCH_COUNT = 8'h58;
-localparam [7:0] ENC_QEI_TIMEBASE = 8'h5C;
-localparam [7:0] ENC_QEI_TB_PRESCALE = 8'h60;
-localparam [7:0] ENC_QEI_SNAP_CTRL = 8'h64;
-localparam [7:0] ENC_QEI_SNAP_PERIOD = 8'h68;
-localparam [7:0] ENC_QEI_SNAP_COUNT_LO = 8'h6C;
-localparam [7:0] ENC_QEI_SNAP_COUNT_HI = 8'h70;
-localparam [7:0] ENC_QEI_SNAP_TIME = 8'h74;
-localparam [7:0] ENC_QEI_SNAP_EDGE_TIME = 8'h78;
-localparam [7:0] ENC_QEI_SNAP_DELTA = 8'h7C;
-localparam [7:0] ENC_QEI_SNAP_EDGE_DELTA = 8'h80;
-localparam [7:0] ENC_QEI_PERIOD_CTRL = 8'h84;
-localparam [7:0] ENC_QEI_PERIOD = 8'h88;
-localparam [7:0] ENC_QEI_STALL_TIMEOUT = 8'h8C;
+// Pages: channel k's registers at ENC_QEI_PAGE * k + their offset; page 0 also holds
+// the global registers
+localparam integer ENC_QEI_PAGE = 256, ENC_QEI_CHANNELS_MAX = 16;
+
+// Register byte offsets in their page
+localparam [7:0] ENC_QEI_ID = 8'h00;  // glb
+localparam [7:0] ENC_QEI_CAPS = 8'h04;  // glb
+localparam [7:0] ENC_QEI_CTRL = 8'h08;  // chan
+localparam [7:0] ENC_QEI_STATUS = 8'h0C;  // chan
+localparam [7:0] ENC_QEI_COUNT_LO = 8'h10;  // chan
+localparam [7:0] ENC_QEI_COUNT_HI = 8'h14;  // chan
+localparam [7:0] ENC_QEI_PRESET_LO = 8'h18;  // chan
+localparam [7:0] ENC_QEI_PRESET_HI = 8'h1C;  // chan
+localparam [7:0] ENC_QEI_CEILING_LO = 8'h20;  // chan
+localparam [7:0] ENC_QEI_CEILING_HI = 8'h24;  // chan
+localparam [7:0] ENC_QEI_COMPARE_LO = 8'h28;  // chan
+localparam [7:0] ENC_QEI_COMPARE_HI = 8'h2C;  // chan
+localparam [7:0] ENC_QEI_INDEX_CTRL = 8'h30;  // chan
+localparam [7:0] ENC_QEI_INDEX_LATCH_LO = 8'h34;  // chan
+localparam [7:0] ENC_QEI_INDEX_LATCH_HI = 8'h38;  // chan
+localparam [7:0] ENC_QEI_PROBE_CTRL = 8'h3C;  // chan
+localparam [7:0] ENC_QEI_PROBE_LATCH_LO = 8'h40;  // chan
+localparam [7:0] ENC_QEI_PROBE_LATCH_HI = 8'h44;  // chan
+localparam [7:0] ENC_QEI_PROBE_TIME = 8'h48;  // chan
+localparam [7:0] ENC_QEI_EVENTS = 8'h4C;  // chan
+localparam [7:0] ENC_QEI_IRQ_EN = 8'h50;  // chan
+localparam [7:0] ENC_QEI_QERR_COUNT = 8'h54;  // chan
+localparam [7:0] ENC_QEI_GLITCH_COUNT = 8'h58;  // chan
+localparam [7:0] ENC_QEI_TIMEBASE = 8'h5C;  // glb
+localparam [7:0] ENC_QEI_TB_PRESCALE = 8'h60;  // glb
+localparam [7:0] ENC_QEI_SNAP_CTRL = 8'h64;  // chan
+localparam [7:0] ENC_QEI_SNAP_PERIOD = 8'h68;  // chan
+localparam [7:0] ENC_QEI_SNAP_COUNT_LO = 8'h6C;  // chan
+localparam [7:0] ENC_QEI_SNAP_COUNT_HI = 8'h70;  // chan
+localparam [7:0] ENC_QEI_SNAP_TIME = 8'h74;  // chan
+localparam [7:0] ENC_QEI_SNAP_EDGE_TIME = 8'h78;  // chan
+localparam [7:0] ENC_QEI_SNAP_DELTA = 8'h7C;  // chan
+localparam [7:0] ENC_QEI_SNAP_EDGE_DELTA = 8'h80;  // chan
+localparam [7:0] ENC_QEI_PERIOD_CTRL = 8'h84;  // chan
+localparam [7:0] ENC_QEI_PERIOD = 8'h88;  // chan
+localparam [7:0] ENC_QEI_STALL_TIMEOUT = 8'h8C;  // chan
+localparam [7:0] ENC_QEI_GSNAP_CTRL = 8'h90;  // glb
+localparam [7:0] ENC_QEI_GSNAP_PERIOD = 8'h94;  // glb
+localparam [7:0] ENC_QEI_GSNAP_TIME = 8'h98;  // glb
+localparam [7:0] ENC_QEI_IRQ_SUMMARY = 8'h9C;  // glb
 
 // Field positions: lsb, and _W the width
 localparam integer ENC_QEI_ID_VERSION = 0, ENC_QEI_ID_VERSION_W = 16;
@@ -50,6 +58,8 @@ localparam integer ENC_QEI_CAPS_TS_W = 8, ENC_QEI_CAPS_TS_W_W = 8;
 localparam integer ENC_QEI_CAPS_INDEX = 16, ENC_QEI_CAPS_INDEX_W = 1;
 localparam integer ENC_QEI_CAPS_PROBE = 17, ENC_QEI_CAPS_PROBE_W = 1;
 localparam integer ENC_QEI_CAPS_TIMING = 18, ENC_QEI_CAPS_TIMING_W = 1;
+localparam integer ENC_QEI_CAPS_PROFILE = 19, ENC_QEI_CAPS_PROFILE_W = 3;
+localparam integer ENC_QEI_CAPS_CHANNELS = 22, ENC_QEI_CAPS_CHANNELS_W = 5;
 localparam integer ENC_QEI_CTRL_EN = 0, ENC_QEI_CTRL_EN_W = 1;
 localparam integer ENC_QEI_CTRL_SWAP_AB = 1, ENC_QEI_CTRL_SWAP_AB_W = 1;
 localparam integer ENC_QEI_CTRL_INV_A = 2, ENC_QEI_CTRL_INV_A_W = 1;
@@ -124,8 +134,18 @@ localparam integer ENC_QEI_PERIOD_CTRL_OVERFLOW = 16, ENC_QEI_PERIOD_CTRL_OVERFL
 localparam integer ENC_QEI_PERIOD_CTRL_DIR_CHANGE = 17, ENC_QEI_PERIOD_CTRL_DIR_CHANGE_W = 1;
 localparam integer ENC_QEI_PERIOD_VALUE = 0, ENC_QEI_PERIOD_VALUE_W = 32;
 localparam integer ENC_QEI_STALL_TIMEOUT_VALUE = 0, ENC_QEI_STALL_TIMEOUT_VALUE_W = 32;
+localparam integer ENC_QEI_GSNAP_CTRL_CMD = 0, ENC_QEI_GSNAP_CTRL_CMD_W = 1;
+localparam integer ENC_QEI_GSNAP_CTRL_IN_EN = 1, ENC_QEI_GSNAP_CTRL_IN_EN_W = 1;
+localparam integer ENC_QEI_GSNAP_CTRL_PERIOD_EN = 2, ENC_QEI_GSNAP_CTRL_PERIOD_EN_W = 1;
+localparam integer ENC_QEI_GSNAP_PERIOD_VALUE = 0, ENC_QEI_GSNAP_PERIOD_VALUE_W = 32;
+localparam integer ENC_QEI_GSNAP_TIME_VALUE = 0, ENC_QEI_GSNAP_TIME_VALUE_W = 32;
+localparam integer ENC_QEI_IRQ_SUMMARY_PENDING = 0, ENC_QEI_IRQ_SUMMARY_PENDING_W = 16;
 
 // Enum codes (RDL enum types), sized to their fields
+localparam [2:0] ENC_QEI_PROFILE_COUNTING = 3'd1;
+localparam [2:0] ENC_QEI_PROFILE_FULL = 3'd2;
+localparam [2:0] ENC_QEI_PROFILE_LEAN = 3'd3;
+localparam integer ENC_QEI_PROFILE_N = 3;
 localparam [3:0] ENC_QEI_FUNC_X4 = 4'd0;
 localparam [3:0] ENC_QEI_FUNC_X2A = 4'd1;
 localparam [3:0] ENC_QEI_FUNC_X2B = 4'd2;
@@ -156,8 +176,24 @@ localparam [0:0] ENC_QEI_EDGE_TYPE_A_RISING = 1'd1;
 localparam integer ENC_QEI_EDGE_TYPE_N = 2;
 
 // The register block's bundles (rtl/enc_qei_regs.v; the fields by name:
-// enc_qei_regs_fields.vh): widths, and the lsb of each field
-localparam integer ENC_QEI_R2H_W = 402, ENC_QEI_H2R_W = 525;
+// enc_qei_regs_fields.vh, enc_qei_chan_fields.vh): widths, and each field's lsb
+localparam integer ENC_QEI_R2H_W = 51, ENC_QEI_H2R_W = 107;
+localparam integer ENC_QEI_R2H_CH_W = 386, ENC_QEI_H2R_CH_W = 474;
+localparam integer ENC_QEI_R2H_TB_PRESCALE_PRESCALE = 0;
+localparam integer ENC_QEI_R2H_GSNAP_CTRL_CMD = 16;
+localparam integer ENC_QEI_R2H_GSNAP_CTRL_IN_EN = 17;
+localparam integer ENC_QEI_R2H_GSNAP_CTRL_PERIOD_EN = 18;
+localparam integer ENC_QEI_R2H_GSNAP_PERIOD = 19;
+localparam integer ENC_QEI_H2R_CAPS_COUNT_W = 0;
+localparam integer ENC_QEI_H2R_CAPS_TS_W = 8;
+localparam integer ENC_QEI_H2R_CAPS_INDEX = 16;
+localparam integer ENC_QEI_H2R_CAPS_PROBE = 17;
+localparam integer ENC_QEI_H2R_CAPS_TIMING = 18;
+localparam integer ENC_QEI_H2R_CAPS_PROFILE = 19;
+localparam integer ENC_QEI_H2R_CAPS_CHANNELS = 22;
+localparam integer ENC_QEI_H2R_TIMEBASE = 27;
+localparam integer ENC_QEI_H2R_GSNAP_TIME = 59;
+localparam integer ENC_QEI_H2R_IRQ_SUMMARY_PENDING = 91;
 localparam integer ENC_QEI_R2H_CTRL_EN = 0;
 localparam integer ENC_QEI_R2H_CTRL_SWAP_AB = 1;
 localparam integer ENC_QEI_R2H_CTRL_INV_A = 2;
@@ -183,58 +219,60 @@ localparam integer ENC_QEI_R2H_PROBE_CTRL_EDGE = 282;
 localparam integer ENC_QEI_R2H_PROBE_CTRL_ONCE = 283;
 localparam integer ENC_QEI_R2H_EVENTS = 284;
 localparam integer ENC_QEI_R2H_IRQ_EN_EN = 296;
-localparam integer ENC_QEI_R2H_TB_PRESCALE_PRESCALE = 308;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_CMD = 324;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_IN_EN = 325;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_PERIOD_EN = 326;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_EDGE = 327;
-localparam integer ENC_QEI_R2H_SNAP_PERIOD = 328;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_EN = 360;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_EDGE = 361;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_N = 362;
-localparam integer ENC_QEI_R2H_STALL_TIMEOUT = 370;
-localparam integer ENC_QEI_H2R_CAPS_COUNT_W = 0;
-localparam integer ENC_QEI_H2R_CAPS_TS_W = 8;
-localparam integer ENC_QEI_H2R_CAPS_INDEX = 16;
-localparam integer ENC_QEI_H2R_CAPS_PROBE = 17;
-localparam integer ENC_QEI_H2R_CAPS_TIMING = 18;
-localparam integer ENC_QEI_H2R_STATUS_A = 19;
-localparam integer ENC_QEI_H2R_STATUS_B = 20;
-localparam integer ENC_QEI_H2R_STATUS_Z = 21;
-localparam integer ENC_QEI_H2R_STATUS_DIR = 22;
-localparam integer ENC_QEI_H2R_STATUS_INDEX_ARMED = 23;
-localparam integer ENC_QEI_H2R_STATUS_STALLED = 24;
-localparam integer ENC_QEI_H2R_STATUS_STOPPED = 25;
-localparam integer ENC_QEI_H2R_STATUS_VALID = 26;
-localparam integer ENC_QEI_H2R_COUNT = 27;
-localparam integer ENC_QEI_H2R_INDEX_CTRL_ARM_CLR = 91;
-localparam integer ENC_QEI_H2R_INDEX_LATCH = 92;
-localparam integer ENC_QEI_H2R_PROBE_CTRL_EN_CLR = 156;
-localparam integer ENC_QEI_H2R_PROBE_LATCH = 157;
-localparam integer ENC_QEI_H2R_PROBE_TIME = 221;
-localparam integer ENC_QEI_H2R_EVENTS_SET = 253;
-localparam integer ENC_QEI_H2R_QERR_COUNT_INCR = 265;
-localparam integer ENC_QEI_H2R_GLITCH_COUNT_INCR = 266;
-localparam integer ENC_QEI_H2R_TIMEBASE = 267;
-localparam integer ENC_QEI_H2R_SNAP_COUNT = 299;
-localparam integer ENC_QEI_H2R_SNAP_TIME = 363;
-localparam integer ENC_QEI_H2R_SNAP_EDGE_TIME = 395;
-localparam integer ENC_QEI_H2R_SNAP_DELTA = 427;
-localparam integer ENC_QEI_H2R_SNAP_EDGE_DELTA = 459;
-localparam integer ENC_QEI_H2R_PERIOD_CTRL_OVERFLOW = 491;
-localparam integer ENC_QEI_H2R_PERIOD_CTRL_DIR_CHANGE = 492;
-localparam integer ENC_QEI_H2R_PERIOD = 493;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_CMD = 308;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_IN_EN = 309;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_PERIOD_EN = 310;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_EDGE = 311;
+localparam integer ENC_QEI_R2H_SNAP_PERIOD = 312;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EN = 344;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EDGE = 345;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_N = 346;
+localparam integer ENC_QEI_R2H_STALL_TIMEOUT = 354;
+localparam integer ENC_QEI_H2R_STATUS_A = 0;
+localparam integer ENC_QEI_H2R_STATUS_B = 1;
+localparam integer ENC_QEI_H2R_STATUS_Z = 2;
+localparam integer ENC_QEI_H2R_STATUS_DIR = 3;
+localparam integer ENC_QEI_H2R_STATUS_INDEX_ARMED = 4;
+localparam integer ENC_QEI_H2R_STATUS_STALLED = 5;
+localparam integer ENC_QEI_H2R_STATUS_STOPPED = 6;
+localparam integer ENC_QEI_H2R_STATUS_VALID = 7;
+localparam integer ENC_QEI_H2R_COUNT = 8;
+localparam integer ENC_QEI_H2R_INDEX_CTRL_ARM_CLR = 72;
+localparam integer ENC_QEI_H2R_INDEX_LATCH = 73;
+localparam integer ENC_QEI_H2R_PROBE_CTRL_EN_CLR = 137;
+localparam integer ENC_QEI_H2R_PROBE_LATCH = 138;
+localparam integer ENC_QEI_H2R_PROBE_TIME = 202;
+localparam integer ENC_QEI_H2R_EVENTS_SET = 234;
+localparam integer ENC_QEI_H2R_QERR_COUNT_INCR = 246;
+localparam integer ENC_QEI_H2R_GLITCH_COUNT_INCR = 247;
+localparam integer ENC_QEI_H2R_SNAP_COUNT = 248;
+localparam integer ENC_QEI_H2R_SNAP_TIME = 312;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_TIME = 344;
+localparam integer ENC_QEI_H2R_SNAP_DELTA = 376;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_DELTA = 408;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_OVERFLOW = 440;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_DIR_CHANGE = 441;
+localparam integer ENC_QEI_H2R_PERIOD = 442;
 // verilator lint_on UNUSEDPARAM
 
-// 1: the byte address is a register of the map (bits 1:0 ignored)
+// 1: the byte address is a register of a build with `channels` channels
 // verilator lint_off UNUSEDSIGNAL
+// verilator lint_off VARHIDDEN
 function enc_qei_mapped;
-  input [7:0] addr;
+  input [15:0] addr;
+  input integer channels;
+  reg glb, chan;
   begin
     case (addr[7:2])
-      6'd0, 6'd1, 6'd2, 6'd3, 6'd4, 6'd5, 6'd6, 6'd7, 6'd8, 6'd9, 6'd10, 6'd11, 6'd12, 6'd13, 6'd14, 6'd15, 6'd16, 6'd17, 6'd18, 6'd19, 6'd20, 6'd21, 6'd22, 6'd23, 6'd24, 6'd25, 6'd26, 6'd27, 6'd28, 6'd29, 6'd30, 6'd31, 6'd32, 6'd33, 6'd34, 6'd35: enc_qei_mapped = 1'b1;
-      default: enc_qei_mapped = 1'b0;
+      6'd0, 6'd1, 6'd23, 6'd24, 6'd36, 6'd37, 6'd38, 6'd39: glb = 1'b1;
+      default: glb = 1'b0;
     endcase
+    case (addr[7:2])
+      6'd2, 6'd3, 6'd4, 6'd5, 6'd6, 6'd7, 6'd8, 6'd9, 6'd10, 6'd11, 6'd12, 6'd13, 6'd14, 6'd15, 6'd16, 6'd17, 6'd18, 6'd19, 6'd20, 6'd21, 6'd22, 6'd25, 6'd26, 6'd27, 6'd28, 6'd29, 6'd30, 6'd31, 6'd32, 6'd33, 6'd34, 6'd35: chan = 1'b1;
+      default: chan = 1'b0;
+    endcase
+    enc_qei_mapped = (glb & (addr[15:8] == 8'd0)) | (chan & ({24'd0, addr[15:8]} < channels));
   end
 endfunction
+// verilator lint_on VARHIDDEN
 // verilator lint_on UNUSEDSIGNAL

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: Apache-2.0
-// enc_qei_timing -- the timing unit of enc_qei: timebase, snapshots, period capture and stall
+// enc_qei_timing -- the timing unit of one enc_qei channel: snapshots, period capture and stall
 // detection (the velocity side of the peripheral: unit-time M, period T and timestamp M/T).
 //
-// Timebase: TS_W bits, +1 every PRESCALE + 1 clocks (`tick`), wrapping; a change of PRESCALE
-// restarts the prescaler. Every time below is in its ticks. The core's edge and step pulses are
+// Every time below is in ticks of the shared timebase (enc_qei_timebase: `timebase`, and `tick`
+// in the clock before it advances). The core's edge and step pulses are
 // registered on the way in (timing), so everything here sees the core one clock late, all alike:
 // an edge's timestamp is the timebase in the clock after the count took it, and a snapshot holds
 // the count register (`count`, which already includes the previous clock's step) with the edges
 // and steps up to that same point. SNAP_CTRL.EDGE, PERIOD_CTRL.EDGE and SNAP_PERIOD act one
 // clock after they change, PERIOD_CTRL.N two (registered on the way in: Fmax).
-// Snapshot: a request -- snap_cmd, a rising edge of snap_in while snap_in_en, or the unit timer
-// (snap_period ticks, 0 acts as 1) while snap_period_en -- latches in one clock (the next):
+// Snapshot: a request (snap_req: the channel's own SNAP_CTRL request or a global snapshot, from
+// enc_qei_snaptrig) latches in its clock:
 //   SNAP_COUNT      the count register now (count)
 //   SNAP_TIME       the timebase now
 //   SNAP_EDGE_TIME  the timestamp of the last edge of the selected type (this clock's included)
@@ -26,15 +26,18 @@
 // previous one inside the measurement (the start edge's own excluded, the end edge's included).
 // Stall: no count step of the count function for stall_timeout ticks (0: off) raises the stall
 // event once and sets `stalled` until the next step.
+// PERIOD = 0 (PROFILE lean) leaves period capture and stall detection out: their outputs are 0.
 `default_nettype none
 
 module enc_qei_timing #(
-    parameter integer COUNT_W = 32,  // counter width, 8 .. 64 (checked by enc_qei)
-    parameter integer TS_W    = 32   // timebase width, 16 .. 32 (checked by enc_qei)
+    parameter integer COUNT_W = 32,  // counter width (checked by enc_qei)
+    parameter integer TS_W    = 32,  // timebase width (checked by enc_qei)
+    parameter integer PERIOD  = 1    // 1: period capture and stall detection, 0: without them
 ) (
     input  wire               clk,
     input  wire               rst,             // synchronous, active high
-    input  wire [15:0]        prescale,        // TB_PRESCALE.PRESCALE
+    input  wire [TS_W-1:0]    timebase,        // the shared timebase
+    input  wire               tick,            // ... advances at the end of this clock
     // from the core, in the clock of the edge / step
     input  wire               edge_any,        // a valid quadrature transition
     input  wire               edge_a_rise,     // a rising edge of A
@@ -43,13 +46,9 @@ module enc_qei_timing #(
     input  wire               applied_dn,      // the count took a -1 step
     input  wire               dir_change,      // a step against the previous step's direction
     input  wire [COUNT_W-1:0] count,           // the count register
-    // snapshot (SNAP_CTRL, SNAP_PERIOD)
-    input  wire               snap_cmd,
-    input  wire               snap_in,
-    input  wire               snap_in_en,
-    input  wire               snap_period_en,
-    input  wire               snap_edge,       // 0 any edge, 1 A rising
-    input  wire [TS_W-1:0]    snap_period,
+    // snapshot
+    input  wire               snap_req,        // take a snapshot in this clock
+    input  wire               snap_edge,       // SNAP_CTRL.EDGE: 0 any edge, 1 A rising
     // period (PERIOD_CTRL)
     input  wire               period_en,
     input  wire               period_edge,     // 0 any edge, 1 A rising
@@ -57,7 +56,6 @@ module enc_qei_timing #(
     // stall
     input  wire [TS_W-1:0]    stall_timeout,
     // outputs
-    output wire [TS_W-1:0]    timebase,
     output wire [COUNT_W-1:0] snap_count,
     output wire [TS_W-1:0]    snap_time,
     output wire [TS_W-1:0]    snap_edge_time,
@@ -82,23 +80,15 @@ module enc_qei_timing #(
   // step adders below: (* keep *) on their blocks keeps Yosys from merging the copies (Fmax: one
   // register driving all three adders' carry chains is a long net).
   reg sel_snap_q;  // an edge of type SNAP_CTRL.EDGE (0 any edge, 1 A rising)
-  reg sel_per_q;   // an edge of type PERIOD_CTRL.EDGE
-  reg step_q, dir_change_q;
   reg mv_d_q, dn_d_q;  // a step up or down (mv), down (dn): for delta_q's adder
   reg mv_t_q, dn_t_q;  // ... tail_q's
   reg mv_a_q, dn_a_q;  // ... acc_q's
 
   always @(posedge clk) begin
     if (rst) begin
-      sel_snap_q   <= 1'b0;
-      sel_per_q    <= 1'b0;
-      step_q       <= 1'b0;
-      dir_change_q <= 1'b0;
+      sel_snap_q <= 1'b0;
     end else begin
-      sel_snap_q   <= snap_edge ? edge_a_rise : edge_any;
-      sel_per_q    <= period_edge ? edge_a_rise : edge_any;
-      step_q       <= step;
-      dir_change_q <= dir_change;
+      sel_snap_q <= snap_edge ? edge_a_rise : edge_any;
     end
   end
 
@@ -117,80 +107,8 @@ module enc_qei_timing #(
     dn_a_q <= ~rst & applied_dn;
   end
 
-  // ---- timebase ----------------------------------------------------------------------------------
-  // The prescaler counts down from PRESCALE to 0 (a tick at 0), with a registered zero flag. A
-  // change of PRESCALE is seen one clock after the new value (restart, a register: Fmax) and
-  // restarts it then.
-  reg [15:0]     pre_q;
-  reg            pre_zero_q;  // pre_q == 0
-  reg [15:0]     prescale_q;  // last clock's PRESCALE
-  reg            restart;     // PRESCALE changed at the last clock edge
-  reg [TS_W-1:0] tb_q;
-
-  wire tick = ~restart & pre_zero_q;
-
-  always @(posedge clk) begin
-    if (rst) begin
-      pre_q      <= 16'd0;
-      pre_zero_q <= 1'b1;
-      prescale_q <= 16'd0;
-      restart    <= 1'b0;
-      tb_q       <= TS_ZERO;
-    end else begin
-      prescale_q <= prescale;
-      restart    <= (prescale != prescale_q);
-      if (restart | tick) begin
-        pre_q      <= prescale;
-        pre_zero_q <= (prescale == 16'd0);
-      end else begin
-        pre_q      <= pre_q - 16'd1;
-        pre_zero_q <= (pre_q == 16'd1);
-      end
-      if (tick) begin
-        tb_q <= tb_q + TS_ONE;
-      end
-    end
-  end
-
   // ---- snapshot ------------------------------------------------------------------------------------
-  // unit timer: counts down from SNAP_PERIOD - 1 once per tick, snaps on the tick at 0
-  // (unit_zero_q: unit_q == 0, a registered flag)
-  // (SNAP_PERIOD - 1 and its zero test are registers: SNAP_PERIOD acts one clock after it
-  // changes, Fmax)
-  reg  [TS_W-1:0] unit_q;
-  reg             unit_zero_q;
-  reg             snap_in_q;
-  reg  [TS_W-1:0] unit_load_q;       // SNAP_PERIOD - 1 (0 for 0)
-  reg             unit_load_zero_q;  // ... == 0 (SNAP_PERIOD 0 or 1)
-  wire            unit_hit  = snap_period_en & tick & unit_zero_q;
-
-  always @(posedge clk) begin
-    unit_load_q      <= (snap_period == TS_ZERO) ? TS_ZERO : snap_period - TS_ONE;
-    unit_load_zero_q <= (snap_period[TS_W-1:1] == {(TS_W-1){1'b0}});
-  end
-  // the request is registered (Fmax): the snapshot is taken in the clock after it, all values
-  // of that one clock
-  reg             snap_req;
-
-  always @(posedge clk) begin
-    if (rst) begin
-      unit_q      <= TS_ZERO;
-      unit_zero_q <= 1'b1;
-      snap_in_q   <= 1'b0;
-      snap_req    <= 1'b0;
-    end else begin
-      snap_in_q <= snap_in;
-      snap_req  <= snap_cmd | (snap_in_en & snap_in & ~snap_in_q) | unit_hit;
-      if (~snap_period_en | unit_hit) begin
-        unit_q      <= unit_load_q;
-        unit_zero_q <= unit_load_zero_q;
-      end else if (tick) begin
-        unit_q      <= unit_q - TS_ONE;
-        unit_zero_q <= (unit_q == TS_ONE);
-      end
-    end
-  end
-
+  wire [TS_W-1:0] tb_q = timebase;
   wire        sel_snap  = sel_snap_q;
   // +1, -1 or 0 (applied_up and applied_dn never come together): straight from registers into
   // the adders' carry chains (Fmax)
@@ -262,163 +180,193 @@ module enc_qei_timing #(
     end
   end
 
-  // ---- period ---------------------------------------------------------------------------------------
-  // (n_last_q: n_q == PERIOD_CTRL.N - 1 as of two clocks ago, so a new N counts from the second
-  // clock after the write; ticks_max_q: ticks_q == all ones; both registered flags: Fmax)
-  wire       sel_per  = sel_per_q;
-  reg        started_q, ovf_q, dir_q, ticks_max_q;
-  reg [7:0]  n_q;
-  reg [TS_W-1:0] ticks_q;
-  reg [TS_W-1:0] period_q;
-  reg        period_ovf_q, period_dir_q;
+  // ---- period capture and stall detection (PERIOD) ---------------------------------------------------
+  generate
+    if (PERIOD != 0) begin : g_period
+    reg sel_per_q;  // an edge of type PERIOD_CTRL.EDGE (registered like sel_snap_q)
+    reg step_q, dir_change_q;
 
-  reg        n_last_q;
-  wire       n_last   = n_last_q;
-  wire capture  = period_en & started_q & sel_per & n_last;
-  wire saturate = period_en & started_q & ~(sel_per & n_last) & tick & ticks_max_q;
-
-  wire [7:0] per_last_d = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
-  reg  [7:0] n_d;  // n_q's next value
-
-  always @(*) begin
-    if (!period_en) begin
-      n_d = n_q;
-    end else if (sel_per & (~started_q | n_last)) begin
-      n_d = 8'd0;
-    end else if (started_q & sel_per) begin
-      n_d = n_q + 8'd1;
-    end else begin
-      n_d = n_q;
-    end
-  end
-
-  // N - 1 and N - 2 as registers (Fmax: PERIOD_CTRL.N reaches the flag a clock later): n_last_q
-  // is set from the next value's case, each compared with them
-  reg [7:0] per_last_q;       // N - 1 (0 for N = 0)
-  reg [7:0] per_last_m1_q;    // ... - 1
-  reg       per_last_zero_q;  // ... == 0
-
-  always @(posedge clk) begin
-    per_last_q      <= per_last_d;
-    per_last_m1_q   <= per_last_d - 8'd1;
-    per_last_zero_q <= (per_last_d == 8'd0);
-  end
-
-  reg n_last_d;  // n_d == per_last_q
-
-  always @(*) begin
-    if (!period_en) begin
-      n_last_d = (n_q == per_last_q);
-    end else if (sel_per & (~started_q | n_last)) begin
-      n_last_d = per_last_zero_q;
-    end else if (started_q & sel_per) begin
-      n_last_d = (n_q == per_last_m1_q);
-    end else begin
-      n_last_d = (n_q == per_last_q);
-    end
-  end
-
-  always @(posedge clk) begin
-    if (rst) begin
-      n_q      <= 8'd0;
-      n_last_q <= 1'b1;
-    end else begin
-      n_q      <= n_d;
-      n_last_q <= n_last_d;
-    end
-  end
-
-  always @(posedge clk) begin
-    if (rst) begin
-      started_q    <= 1'b0;
-      ovf_q        <= 1'b0;
-      dir_q        <= 1'b0;
-      ticks_q      <= TS_ZERO;
-      ticks_max_q  <= 1'b0;
-      period_q     <= TS_ZERO;
-      period_ovf_q <= 1'b0;
-      period_dir_q <= 1'b0;
-    end else if (!period_en) begin
-      started_q <= 1'b0;
-    end else if (sel_per & (~started_q | n_last)) begin
-      // a start edge (the first, or the end edge of the last measurement)
-      started_q   <= 1'b1;
-      ovf_q       <= 1'b0;
-      dir_q       <= 1'b0;
-      ticks_q     <= tick ? TS_ONE : TS_ZERO;
-      ticks_max_q <= 1'b0;
-      if (started_q) begin  // (capture)
-        period_q     <= ovf_q ? TS_MAX : ticks_q;
-        period_ovf_q <= ovf_q;
-        period_dir_q <= dir_q | dir_change_q;
+    always @(posedge clk) begin
+      if (rst) begin
+        sel_per_q    <= 1'b0;
+        step_q       <= 1'b0;
+        dir_change_q <= 1'b0;
+      end else begin
+        sel_per_q    <= period_edge ? edge_a_rise : edge_any;
+        step_q       <= step;
+        dir_change_q <= dir_change;
       end
-    end else if (started_q) begin
-      dir_q <= dir_q | dir_change_q;
-      if (tick) begin
-        if (ticks_max_q) begin
-          ovf_q <= 1'b1;
-        end else begin
-          ticks_q     <= ticks_q + TS_ONE;
-          ticks_max_q <= (ticks_q == (TS_MAX - TS_ONE));
+    end
+
+    // ---- period ---------------------------------------------------------------------------------------
+    // (n_last_q: n_q == PERIOD_CTRL.N - 1 as of two clocks ago, so a new N counts from the second
+    // clock after the write; ticks_max_q: ticks_q == all ones; both registered flags: Fmax)
+    wire       sel_per  = sel_per_q;
+    reg        started_q, ovf_q, dir_q, ticks_max_q;
+    reg [7:0]  n_q;
+    reg [TS_W-1:0] ticks_q;
+    reg [TS_W-1:0] period_q;
+    reg        period_ovf_q, period_dir_q;
+
+    reg        n_last_q;
+    wire       n_last   = n_last_q;
+    wire capture  = period_en & started_q & sel_per & n_last;
+    wire saturate = period_en & started_q & ~(sel_per & n_last) & tick & ticks_max_q;
+
+    wire [7:0] per_last_d = (period_n == 8'd0) ? 8'd0 : period_n - 8'd1;
+    reg  [7:0] n_d;  // n_q's next value
+
+    always @(*) begin
+      if (!period_en) begin
+        n_d = n_q;
+      end else if (sel_per & (~started_q | n_last)) begin
+        n_d = 8'd0;
+      end else if (started_q & sel_per) begin
+        n_d = n_q + 8'd1;
+      end else begin
+        n_d = n_q;
+      end
+    end
+
+    // N - 1 and N - 2 as registers (Fmax: PERIOD_CTRL.N reaches the flag a clock later): n_last_q
+    // is set from the next value's case, each compared with them
+    reg [7:0] per_last_q;       // N - 1 (0 for N = 0)
+    reg [7:0] per_last_m1_q;    // ... - 1
+    reg       per_last_zero_q;  // ... == 0
+
+    always @(posedge clk) begin
+      per_last_q      <= per_last_d;
+      per_last_m1_q   <= per_last_d - 8'd1;
+      per_last_zero_q <= (per_last_d == 8'd0);
+    end
+
+    reg n_last_d;  // n_d == per_last_q
+
+    always @(*) begin
+      if (!period_en) begin
+        n_last_d = (n_q == per_last_q);
+      end else if (sel_per & (~started_q | n_last)) begin
+        n_last_d = per_last_zero_q;
+      end else if (started_q & sel_per) begin
+        n_last_d = (n_q == per_last_m1_q);
+      end else begin
+        n_last_d = (n_q == per_last_q);
+      end
+    end
+
+    always @(posedge clk) begin
+      if (rst) begin
+        n_q      <= 8'd0;
+        n_last_q <= 1'b1;
+      end else begin
+        n_q      <= n_d;
+        n_last_q <= n_last_d;
+      end
+    end
+
+    always @(posedge clk) begin
+      if (rst) begin
+        started_q    <= 1'b0;
+        ovf_q        <= 1'b0;
+        dir_q        <= 1'b0;
+        ticks_q      <= TS_ZERO;
+        ticks_max_q  <= 1'b0;
+        period_q     <= TS_ZERO;
+        period_ovf_q <= 1'b0;
+        period_dir_q <= 1'b0;
+      end else if (!period_en) begin
+        started_q <= 1'b0;
+      end else if (sel_per & (~started_q | n_last)) begin
+        // a start edge (the first, or the end edge of the last measurement)
+        started_q   <= 1'b1;
+        ovf_q       <= 1'b0;
+        dir_q       <= 1'b0;
+        ticks_q     <= tick ? TS_ONE : TS_ZERO;
+        ticks_max_q <= 1'b0;
+        if (started_q) begin  // (capture)
+          period_q     <= ovf_q ? TS_MAX : ticks_q;
+          period_ovf_q <= ovf_q;
+          period_dir_q <= dir_q | dir_change_q;
+        end
+      end else if (started_q) begin
+        dir_q <= dir_q | dir_change_q;
+        if (tick) begin
+          if (ticks_max_q) begin
+            ovf_q <= 1'b1;
+          end else begin
+            ticks_q     <= ticks_q + TS_ONE;
+            ticks_max_q <= (ticks_q == (TS_MAX - TS_ONE));
+          end
         end
       end
     end
-  end
 
-  // ---- stall ----------------------------------------------------------------------------------------
-  // counts down from STALL_TIMEOUT - 1 once per tick after each step (or a change of
-  // STALL_TIMEOUT); the tick at 0 stalls (stall_zero_q: stall_q == 0, a registered flag). A new
-  // STALL_TIMEOUT (and 0 = off) is seen one clock after it appears (registered compares: Fmax).
-  reg  [TS_W-1:0] stall_q;
-  reg  [TS_W-1:0] stall_timeout_q;
-  reg             stalled_q, stall_zero_q;
-  reg             stall_off;  // STALL_TIMEOUT was 0 in the last clock
-  reg             stall_new;  // STALL_TIMEOUT changed at the last clock edge
-  wire            stall_hit = ~stall_off & ~stall_new & ~stalled_q & ~step_q & tick & stall_zero_q;
+    // ---- stall ----------------------------------------------------------------------------------------
+    // counts down from STALL_TIMEOUT - 1 once per tick after each step (or a change of
+    // STALL_TIMEOUT); the tick at 0 stalls (stall_zero_q: stall_q == 0, a registered flag). A new
+    // STALL_TIMEOUT (and 0 = off) is seen one clock after it appears (registered compares: Fmax).
+    reg  [TS_W-1:0] stall_q;
+    reg  [TS_W-1:0] stall_timeout_q;
+    reg             stalled_q, stall_zero_q;
+    reg             stall_off;  // STALL_TIMEOUT was 0 in the last clock
+    reg             stall_new;  // STALL_TIMEOUT changed at the last clock edge
+    wire            stall_hit = ~stall_off & ~stall_new & ~stalled_q & ~step_q & tick & stall_zero_q;
 
-  always @(posedge clk) begin
-    if (rst) begin
-      stall_timeout_q <= TS_ZERO;
-      stall_off       <= 1'b1;
-      stall_new       <= 1'b0;
-    end else begin
-      stall_timeout_q <= stall_timeout;
-      stall_off       <= (stall_timeout == TS_ZERO);
-      stall_new       <= (stall_timeout != stall_timeout_q);
+    always @(posedge clk) begin
+      if (rst) begin
+        stall_timeout_q <= TS_ZERO;
+        stall_off       <= 1'b1;
+        stall_new       <= 1'b0;
+      end else begin
+        stall_timeout_q <= stall_timeout;
+        stall_off       <= (stall_timeout == TS_ZERO);
+        stall_new       <= (stall_timeout != stall_timeout_q);
+      end
     end
-  end
 
-  always @(posedge clk) begin
-    if (rst) begin
-      stall_q      <= TS_ZERO;
-      stall_zero_q <= 1'b1;
-      stalled_q    <= 1'b0;
-    end else if (step_q | stall_off | stall_new) begin
-      stall_q      <= stall_timeout - TS_ONE;
-      stall_zero_q <= (stall_timeout == TS_ONE);
-      stalled_q    <= 1'b0;
-    end else if (tick & ~stalled_q) begin
-      stall_q      <= stall_q - TS_ONE;
-      stall_zero_q <= (stall_q == TS_ONE);
-      stalled_q    <= stall_hit;
+    always @(posedge clk) begin
+      if (rst) begin
+        stall_q      <= TS_ZERO;
+        stall_zero_q <= 1'b1;
+        stalled_q    <= 1'b0;
+      end else if (step_q | stall_off | stall_new) begin
+        stall_q      <= stall_timeout - TS_ONE;
+        stall_zero_q <= (stall_timeout == TS_ONE);
+        stalled_q    <= 1'b0;
+      end else if (tick & ~stalled_q) begin
+        stall_q      <= stall_q - TS_ONE;
+        stall_zero_q <= (stall_q == TS_ONE);
+        stalled_q    <= stall_hit;
+      end
     end
-  end
+
+    assign period          = period_q;
+    assign period_ovf_flag = period_ovf_q;
+    assign period_dir_flag = period_dir_q;
+    assign stalled         = stalled_q;
+    assign ev_period       = capture;
+    assign ev_period_ovf   = saturate & ~ovf_q;
+    assign ev_stall        = stall_hit;
+    end else begin : g_no_period
+      wire unused_period = &{1'b0, tick, step, dir_change, period_en, period_edge, period_n,
+                             stall_timeout};
+      assign period          = TS_ZERO;
+      assign period_ovf_flag = 1'b0;
+      assign period_dir_flag = 1'b0;
+      assign stalled         = 1'b0;
+      assign ev_period       = 1'b0;
+      assign ev_period_ovf   = 1'b0;
+      assign ev_stall        = 1'b0;
+    end
+  endgenerate
 
   // ---- outputs -----------------------------------------------------------------------------------------
-  assign timebase        = tb_q;
   assign snap_count      = snap_count_q;
   assign snap_time       = snap_time_q;
   assign snap_edge_time  = snap_edge_time_q;
   assign snap_delta      = snap_delta_q;
   assign snap_edge_delta = snap_edge_delta_q;
-  assign period          = period_q;
-  assign period_ovf_flag = period_ovf_q;
-  assign period_dir_flag = period_dir_q;
-  assign stalled         = stalled_q;
   assign ev_snap         = snap_req;
-  assign ev_period       = capture;
-  assign ev_period_ovf   = saturate & ~ovf_q;
-  assign ev_stall        = stall_hit;
 
 endmodule
 

@@ -12,15 +12,17 @@
 `include "enc_params.vh"
 
 module enc_qei_wb #(
-    parameter integer COUNT_W    = 32,  // counter width: 8 .. 64
-    parameter integer TS_W       = 32,  // timebase / timestamp width: 16 .. 32
-    parameter integer PROFILE    = 2,   // 2: full (with the timing unit), 1: counting only (see enc_qei)
+    parameter integer CHANNELS   = 1,   // encoder channels (see enc_qei)
+    parameter integer ADDR_W     = `ENC_QEI_ADDR_W(CHANNELS),  // byte address bits (see enc_qei)
+    parameter integer COUNT_W    = 32,  // counter width in bits
+    parameter integer TS_W       = 32,  // timebase / timestamp width in bits
+    parameter integer PROFILE    = 2,   // 2 full, 1 counting, 3 lean (see enc_qei)
     parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,       // synchronous, active high
     // Wishbone B4 classic slave
-    input  wire [7:0]  wb_adr_i,  // byte address (bits 1:0 ignored)
+    input  wire [ADDR_W-1:0] wb_adr_i,  // byte address (bits 1:0 ignored)
     input  wire [31:0] wb_dat_i,
     output wire [31:0] wb_dat_o,
     input  wire [3:0]  wb_sel_i,
@@ -30,16 +32,18 @@ module enc_qei_wb #(
     output wire        wb_ack_o,
     output wire        wb_err_o,
     // encoder and system
-    input  wire        a_in,      // encoder channel A, asynchronous
-    input  wire        b_in,      // encoder channel B, asynchronous
-    input  wire        z_in,      // index channel, asynchronous
-    input  wire        probe_in,  // external latch input, asynchronous
+    input  wire [CHANNELS-1:0] a_in,     // encoder channel A, asynchronous
+    input  wire [CHANNELS-1:0] b_in,     // encoder channel B, asynchronous
+    input  wire [CHANNELS-1:0] z_in,     // index channel, asynchronous
+    input  wire [CHANNELS-1:0] probe_in, // external latch input, asynchronous
     input  wire        snap_in,   // synchronous snapshot strobe
     output wire        irq,       // level: any enabled pending event
-    output wire        cmp_out    // one-clock pulse on a compare match
+    output wire [CHANNELS-1:0] cmp_out   // one-clock pulse on a compare match
 );
 
   generate
+    `ENC_CHECK_CHANNELS
+    `ENC_CHECK_ADDR_W
     `ENC_CHECK_COUNT_W
     `ENC_CHECK_TS_W
     `ENC_CHECK_PROFILE
@@ -69,6 +73,8 @@ module enc_qei_wb #(
   end
 
   enc_qei #(
+      .CHANNELS  (CHANNELS),
+      .ADDR_W    (ADDR_W),
       .COUNT_W   (COUNT_W),
       .TS_W      (TS_W),
       .PROFILE   (PROFILE),

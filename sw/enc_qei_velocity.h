@@ -105,15 +105,16 @@ qei_vel_reading_t qei_vel_update(qei_vel_t *st, const qei_vel_snap_t *snap);
 double qei_vel_rpm(double counts_per_s, unsigned counts_per_rev);
 
 /*
- * Reading the registers. Include the generated sw/enc_qei_regs.h (C11: it uses static_assert)
- * before this header and qei_vel_read_snapshot() is defined: it takes a snapshot by bus command
+ * Reading the registers. Include the generated sw/enc_qei_regs.h before this header and
+ * qei_vel_read_snapshot() is defined for one channel's page (&q->chan[k]): it takes a snapshot of
+ * that channel by bus command
  * (SNAP_CTRL.CMD, keeping the other SNAP_CTRL fields) and reads it, with PERIOD, PERIOD_CTRL and
  * STATUS right after (those three are live values, not latched with the snapshot). count_w is
  * CAPS.COUNT_W. On a bus that posts writes, make sure the SNAP_CTRL write lands before the
  * reads (a barrier, or read SNAP_CTRL back first).
  */
 #ifdef ENC_QEI_REGS_H
-static inline void qei_vel_read_snapshot(volatile enc_qei_t *q, unsigned count_w,
+static inline void qei_vel_read_snapshot(volatile enc_qei_chan_t *q, unsigned count_w,
                                          qei_vel_snap_t *s)
 {
     uint32_t pc, st;

@@ -19,7 +19,7 @@ uint32_t enc_qei_ctrl_word(uint32_t func, uint32_t range, uint32_t filter_len)
            FIELD(ENC_QEI__CTRL__FILTER_LEN, filter_len);
 }
 
-void enc_qei_setup_x4(volatile enc_qei_t *q, uint32_t filter_len, uint32_t range, uint64_t ceiling)
+void enc_qei_setup_x4(volatile enc_qei_chan_t *q, uint32_t filter_len, uint32_t range, uint64_t ceiling)
 {
     /* CEILING first, so the range never sees a stale bound */
     q->CEILING_HI = (uint32_t)(ceiling >> 32);
@@ -36,7 +36,7 @@ void enc_qei_setup_x4(volatile enc_qei_t *q, uint32_t filter_len, uint32_t range
 
 unsigned enc_qei_count_width(volatile enc_qei_t *q)
 {
-    return (unsigned)((q->CAPS & ENC_QEI__CAPS__COUNT_W_bm) >> ENC_QEI__CAPS__COUNT_W_bp);
+    return (unsigned)((q->glb.CAPS & ENC_QEI__CAPS__COUNT_W_bm) >> ENC_QEI__CAPS__COUNT_W_bp);
 }
 
 uint64_t enc_qei_combine64(uint32_t lo, uint32_t hi)
@@ -59,7 +59,7 @@ int64_t enc_qei_to_signed(uint64_t count, unsigned count_w)
     return (int64_t)count;
 }
 
-uint64_t enc_qei_read_count(volatile enc_qei_t *q)
+uint64_t enc_qei_read_count(volatile enc_qei_chan_t *q)
 {
     /* Two separate volatile accesses, in this order: reading COUNT_LO latches the high word of
      * the same count into COUNT_HI. (COUNT_HI reads 0 when COUNT_W <= 32.) */
@@ -68,20 +68,20 @@ uint64_t enc_qei_read_count(volatile enc_qei_t *q)
     return enc_qei_combine64(lo, hi);
 }
 
-void enc_qei_write_count(volatile enc_qei_t *q, uint64_t value)
+void enc_qei_write_count(volatile enc_qei_chan_t *q, uint64_t value)
 {
     q->COUNT_HI = (uint32_t)(value >> 32); /* staged */
     q->COUNT_LO = (uint32_t)value;         /* loads {staged HI, LO}, clears STATUS.STOPPED */
 }
 
 /* pending INDEX cleared, INDEX enabled onto irq (other enables kept) */
-static void enable_index_irq(volatile enc_qei_t *q)
+static void enable_index_irq(volatile enc_qei_chan_t *q)
 {
     q->EVENTS = ENC_QEI__EVENTS__INDEX_bm;
     q->IRQ_EN = q->IRQ_EN | ENC_QEI__EVENTS__INDEX_bm; /* IRQ_EN bit n enables EVENTS bit n */
 }
 
-void enc_qei_home_preset(volatile enc_qei_t *q, uint64_t home_value, int gate_ab)
+void enc_qei_home_preset(volatile enc_qei_chan_t *q, uint64_t home_value, int gate_ab)
 {
     uint32_t ic;
     q->PRESET_HI = (uint32_t)(home_value >> 32);
@@ -101,7 +101,7 @@ void enc_qei_home_preset(volatile enc_qei_t *q, uint64_t home_value, int gate_ab
     q->INDEX_CTRL = ic; /* armed from here on */
 }
 
-void enc_qei_home_latch(volatile enc_qei_t *q)
+void enc_qei_home_latch(volatile enc_qei_chan_t *q)
 {
     enable_index_irq(q);
     q->INDEX_CTRL = FIELD(ENC_QEI__INDEX_CTRL__ACTION, ENC_QEI__INDEX_CTRL__ACTION__LATCH) |
@@ -109,7 +109,7 @@ void enc_qei_home_latch(volatile enc_qei_t *q)
                     FIELD(ENC_QEI__INDEX_CTRL__ARM, 1u);
 }
 
-int enc_qei_index_irq(volatile enc_qei_t *q)
+int enc_qei_index_irq(volatile enc_qei_chan_t *q)
 {
     uint32_t pending = q->EVENTS & q->IRQ_EN;
     if (!(pending & ENC_QEI__EVENTS__INDEX_bm))
@@ -126,14 +126,14 @@ int enc_qei_index_irq(volatile enc_qei_t *q)
 }
 
 /* (meaningful with RANGE = free, less than 2^(COUNT_W-1) counts from the index) */
-int64_t enc_qei_position_from_latch(volatile enc_qei_t *q, unsigned count_w)
+int64_t enc_qei_position_from_latch(volatile enc_qei_chan_t *q, unsigned count_w)
 {
     uint64_t latch = enc_qei_combine64(q->INDEX_LATCH_LO, q->INDEX_LATCH_HI);
     uint64_t count = enc_qei_read_count(q);
     return enc_qei_to_signed(count - latch, count_w);
 }
 
-int enc_qei_read_errors(volatile enc_qei_t *q, uint32_t *qerr, uint32_t *glitch, int clear)
+int enc_qei_read_errors(volatile enc_qei_chan_t *q, uint32_t *qerr, uint32_t *glitch, int clear)
 {
     *qerr = (q->QERR_COUNT & ENC_QEI__QERR_COUNT__VALUE_bm) >> ENC_QEI__QERR_COUNT__VALUE_bp;
     *glitch = (q->GLITCH_COUNT & ENC_QEI__GLITCH_COUNT__VALUE_bm) >> ENC_QEI__GLITCH_COUNT__VALUE_bp;

@@ -69,8 +69,9 @@ HARNESS = r"""
 #include <string.h>
 #include "enc_qei_example.h"
 
-static enc_qei_t regs;  /* the register block, in memory */
-#define Q ((volatile enc_qei_t *)&regs)
+static enc_qei_chan_t regs;  /* a channel's page, in memory */
+static enc_qei_t all;        /* the whole address space (for the global CAPS) */
+#define Q ((volatile enc_qei_chan_t *)&regs)
 #define P(name, v) printf("%s %llu\n", name, (unsigned long long)(v))
 #define PS(name, v) printf("%s %lld\n", name, (long long)(v))
 
@@ -94,8 +95,8 @@ int main(void)
     P("setup.GLITCH_COUNT", regs.GLITCH_COUNT);
 
     memset(&regs, 0, sizeof regs);
-    regs.CAPS = 0x00072040u; /* COUNT_W 64, TS_W 32, INDEX, PROBE, TIMING */
-    P("count_w", enc_qei_count_width(Q));
+    all.glb.CAPS = 0x00072040u; /* COUNT_W 64, TS_W 32, INDEX, PROBE, TIMING */
+    P("count_w", enc_qei_count_width((volatile enc_qei_t *)&all));
 
     P("combine", enc_qei_combine64(0xFFFFFFF0u, 2u));
     regs.COUNT_LO = 0x89ABCDEFu;

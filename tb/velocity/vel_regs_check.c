@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* qei_vel_read_snapshot() against a register block in memory laid out by the generated
- * sw/enc_qei_regs.h (built by tb/velocity/test_velocity_estimators.py, -std=c11: the generated
- * header uses static_assert). Prints the snapshot it read. */
+ * sw/enc_qei_regs.h (one channel's page; built by tb/velocity/test_velocity_estimators.py). Prints
+ * the snapshot it read. */
 #include <stdio.h>
 #include <string.h>
 
@@ -10,7 +10,7 @@
 
 int main(void)
 {
-    enc_qei_t q;
+    enc_qei_chan_t q;
     qei_vel_snap_t s;
     memset(&q, 0, sizeof q);
     q.SNAP_CTRL = ENC_QEI__SNAP_CTRL__EDGE_bm;

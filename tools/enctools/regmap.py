@@ -2,9 +2,14 @@
 """rtl/enc_qei.rdl, compiled once: the one reader of the register map for every Python consumer
 (the generators, the tests, the benches and the demo).
 
-``compile_rdl()`` gives the systemrdl-compiler node tree; ``regmap()`` a plain view of it
-(registers by name with offset and fields: position, access, reset, size property, enum
-members); helpers pack and unpack register words by field and enum member names.
+The map is paged: page k (0x100 bytes) holds channel k's registers (the RDL's regfile array
+``ch.chan``), at the same offsets in every page; page 0 also holds the global registers
+(``glb``), at offsets no channel register uses. ``compile_rdl()`` gives the systemrdl-compiler
+node tree; ``nodes()`` every register node with its group ("glb" or "chan") and its offset in a
+page; ``regmap()`` a plain view (registers by name with group, offset and fields: position,
+access, reset, size property, enum members); ``addr(reg, chan)`` a register's byte address; the
+helpers pack and unpack register words by field and enum member names. An RDL of an older
+revision (one flat map) reads as one page of channel registers.
 """
 
 from __future__ import annotations
@@ -62,18 +67,23 @@ class Field:
     sized_by: str | None
     enum: dict | None  # member name -> value
     kind: str
+    feature: str | None = None  # the optional unit the field belongs to (reads 0 without it)
 
     @property
     def mask(self) -> int:
         return ((1 << self.width) - 1) << self.lsb
 
 
+PAGE = 0x100  # bytes per channel page
+
+
 @dataclass(frozen=True)
 class Reg:
     name: str
-    offset: int
+    offset: int  # in its page (channel registers: the same in every page)
     feature: str | None
     fields: dict  # name -> Field, in bit order
+    group: str = "chan"  # "glb": a global register (page 0 only); "chan": one per channel
 
     @property
     def coherent(self) -> bool:
@@ -94,24 +104,59 @@ def _feature(reg) -> str | None:
 
 
 @lru_cache(maxsize=None)
+def nodes(path: Path = RDL) -> list[tuple[str, int, object]]:
+    """(group, offset in the page, register node) of every register, in page-offset order;
+    raises ValueError when a global register shares an offset with a channel register."""
+    top = compile_rdl(path)
+    children = {c.inst_name: c for c in top.children()}
+    if "glb" in children and "ch" in children:
+        out = [("glb", r.address_offset, r) for r in children["glb"].registers()]
+        chan = children["ch"].get_child_by_name("chan")
+        out += [("chan", chan.raw_address_offset + r.address_offset, r) for r in chan.registers()]
+    else:  # an older, flat map: one channel page
+        out = [("chan", r.address_offset, r) for r in top.registers()]
+    seen: dict[int, str] = {}
+    for g, off, r in out:
+        if off in seen:
+            raise ValueError(f"{r.inst_name} at 0x{off:02X} collides with {seen[off]}")
+        seen[off] = r.inst_name
+    return sorted(out, key=lambda x: x[1])
+
+
+def channels_max(path: Path = RDL) -> int:
+    """The number of channel pages the map has room for (the regfile array's size)."""
+    top = compile_rdl(path)
+    names = [c.inst_name for c in top.children()]
+    if "ch" not in names:
+        return 1
+    return top.get_child_by_name("ch").get_child_by_name("chan").array_dimensions[0]
+
+
+@lru_cache(maxsize=None)
 def regmap(path: Path = RDL) -> dict[str, Reg]:
-    """Registers by name, in address order (``path``: another RDL than rtl/enc_qei.rdl, e.g. the
-    one of a git revision a bench simulates)."""
+    """Registers by name, in page-offset order (``path``: another RDL than rtl/enc_qei.rdl, e.g.
+    the one of a git revision a bench simulates)."""
     regs = {}
-    for r in compile_rdl(path).registers():
+    for group, offset, r in nodes(path):
         fields = {}
         for f in r.fields():
             enc = f.get_property("encode")
             fields[f.inst_name] = Field(
                 f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
                 f.get_property("reset"), f.get_property("sized_by"),
-                {m.name: m.value for m in enc} if enc is not None else None, field_kind(f))
-        regs[r.inst_name] = Reg(r.inst_name, r.address_offset, _feature(r), fields)
+                {m.name: m.value for m in enc} if enc is not None else None, field_kind(f),
+                _udp(f, "feature"))
+        regs[r.inst_name] = Reg(r.inst_name, offset, _feature(r), fields, group)
     return regs
 
 
-def addr(reg: str) -> int:
-    return regmap()[reg].offset
+def addr(reg: str, chan: int = 0) -> int:
+    """The byte address of a register: channel ``chan``'s (a channel register), or page 0's (a
+    global register, chan 0)."""
+    r = regmap()[reg]
+    if r.group == "glb" and chan != 0:
+        raise ValueError(f"{reg} is a global register (page 0 only)")
+    return chan * PAGE + r.offset
 
 
 def field(reg: str, name: str) -> Field:

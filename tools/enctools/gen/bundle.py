@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The register block's two bundles, from the compiled RDL: ``reg2hw`` (what the registers give
-the hardware: configuration, pulses, pending events, the count to load) and ``hw2reg`` (what the
+"""The register block's bundles, from the compiled RDL: ``reg2hw`` (what the registers give the
+hardware: configuration, pulses, pending events, the count to load) and ``hw2reg`` (what the
 hardware gives the registers: live values, event and counter strobes, hardware clears, the
-count). OpenTitan's reg2hw / hw2reg structures, as Verilog-2005 vectors with fixed positions.
+count). OpenTitan's reg2hw / hw2reg structures, as Verilog-2005 vectors with fixed positions:
+one pair for the global registers (``glb``) and one pair per channel (``chan``).
 
 One entry per field, named ``<reg>_<field>`` in lower case (``ctrl_func``), with these merges:
 - a register whose only field is VALUE gives ``<reg>`` (``snap_period``);
@@ -18,7 +19,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..regmap import field_kind
+from ..regmap import field_kind, nodes
+from . import HEADER_V
+
+GROUPS = ("glb", "chan")
 
 
 @dataclass
@@ -43,11 +47,11 @@ class Bundles:
 
     @property
     def r2h_w(self) -> int:
-        return sum(e.width for e in self.r2h)
+        return max(1, sum(e.width for e in self.r2h))
 
     @property
     def h2r_w(self) -> int:
-        return sum(e.width for e in self.h2r)
+        return max(1, sum(e.width for e in self.h2r))
 
     def add(self, side: str, name: str, width: int, desc: str) -> Entry:
         lst = self.r2h if side == "r2h" else self.h2r
@@ -57,6 +61,9 @@ class Bundles:
         e = Entry(name, width, desc, sum(x.width for x in lst))
         lst.append(e)
         return e
+
+    def entry(self, side: str, name: str) -> Entry:
+        return next(e for e in (self.r2h if side == "r2h" else self.h2r) if e.name == name)
 
 
 def pair_base(reg) -> tuple[str, int] | None:
@@ -80,19 +87,23 @@ def entry_name(reg, f) -> str:
     return f"{reg.inst_name}_{f.inst_name}".lower()
 
 
-def build(top) -> Bundles:
+def group_regs(group: str) -> list:
+    """The register nodes of a group, in page-offset order."""
+    return [r for g, _, r in nodes() if g == group]
+
+
+def build(group: str) -> Bundles:
     b = Bundles()
-    for reg in top.registers():
+    for reg in group_regs(group):
         rn = reg.inst_name
         intr_top = max((f.msb for f in reg.fields() if field_kind(f) == "intr"), default=-1)
         for f in reg.fields():
             kind, desc = field_kind(f), f"{rn}.{f.inst_name}"
-            coherent = f.get_property("coherent")
             pair = pair_base(reg)
             if kind == "coherent":
                 e = b.add("h2r", "count", 64, "the live count (COUNT_W bits, zero-extended)")
-                b.where[(rn, f.inst_name)] = ("h2r", e, 32 if coherent == "hi" else 0)
-                if coherent == "lo":
+                b.where[(rn, f.inst_name)] = ("h2r", e, 32 if f.get_property("coherent") == "hi" else 0)
+                if f.get_property("coherent") == "lo":
                     b.add("r2h", "count_load", 1, "load the count: a COUNT_LO write")
                     b.add("r2h", "count_load_value", 64,
                           "the value to load: {word staged by COUNT_HI, COUNT_LO word}")
@@ -119,24 +130,24 @@ def build(top) -> Bundles:
     return b
 
 
-def render_fields(top) -> str:
-    """rtl/enc_qei_regs_fields.vh: named wires over the bundles, for the module that connects the
-    register block (it declares `reg2hw` and `hw2reg` first): r2h_<entry> to read, h2r_<entry>
-    to drive."""
-    from . import HEADER_V
-
-    b = build(top)
-    lines = [*HEADER_V, "// The fields of the register block's bundles by name (rtl/enc_qei_regs.v). Include it",
-             "// inside the module that instantiates the block, after declaring",
-             "//   wire [ENC_QEI_R2H_W-1:0] reg2hw;  wire [ENC_QEI_H2R_W-1:0] hw2reg;",
-             "// then read r2h_<name> and drive every h2r_<name>.",
+def render_fields(group: str) -> str:
+    """The named wires over one group's bundles: rtl/enc_qei_regs_fields.vh (glb: for enc_qei,
+    over its reg2hw_g / hw2reg_g) and rtl/enc_qei_chan_fields.vh (chan: for enc_qei_channel,
+    over its reg2hw / hw2reg ports): r2h_<entry> to read, h2r_<entry> to drive."""
+    b = build(group)
+    r2h, h2r = ("reg2hw_g", "hw2reg_g") if group == "glb" else ("reg2hw", "hw2reg")
+    what = ("the global registers' bundles, for enc_qei (declare reg2hw_g and hw2reg_g first)"
+            if group == "glb" else
+            "one channel's bundles, for enc_qei_channel (its ports reg2hw and hw2reg)")
+    lines = [*HEADER_V, f"// The fields of {what}: read r2h_<name>,",
+             "// drive every h2r_<name> (rtl/enc_qei_regs.v; tools/enctools/gen/bundle.py).",
              "// verilator lint_off UNUSEDSIGNAL"]
     for e in b.r2h:
         rng = f"[{e.width - 1}:0] " if e.width > 1 else ""
-        lines.append(f"wire {rng}r2h_{e.name} = reg2hw{e.rng};  // {e.desc}")
+        lines.append(f"wire {rng}r2h_{e.name} = {r2h}{e.rng};  // {e.desc}")
     lines.append("// verilator lint_on UNUSEDSIGNAL")
     for e in b.h2r:
         rng = f"[{e.width - 1}:0] " if e.width > 1 else ""
         lines.append(f"wire {rng}h2r_{e.name};  // {e.desc}")
-    lines.append("assign hw2reg = {" + ", ".join(f"h2r_{e.name}" for e in reversed(b.h2r)) + "};")
+    lines.append(f"assign {h2r} = {{" + ", ".join(f"h2r_{e.name}" for e in reversed(b.h2r)) + "};")
     return "\n".join(lines) + "\n"

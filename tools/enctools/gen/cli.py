@@ -4,7 +4,8 @@ instead (exit 1, naming the stale files, with a diff). All outputs are committed
 
   rtl/enc_qei_regs.v          the register block (regblock)
   rtl/enc_qei_regs.vh         the map for Verilog: offsets, fields, enum codes (regs_vh)
-  rtl/enc_qei_regs_fields.vh  the register block's bundle fields by name (bundle)
+  rtl/enc_qei_regs_fields.vh  the global bundles' fields by name (bundle)
+  rtl/enc_qei_chan_fields.vh  a channel's bundle fields by name (bundle)
   rtl/enc_params.vh           the parameter guards, from enc_ip.core's ranges (params_vh)
   formal/enc_qei_regs_table.vh  the map as tables for the register block's proof (regs_table)
   sw/enc_qei_regs.h           the C header (c_header)
@@ -26,6 +27,7 @@ from . import bundle, c_header, markdown, params_vh, regblock, regs_table, regs_
 OUT_V = TOP / "rtl" / "enc_qei_regs.v"
 OUT_VH = TOP / "rtl" / "enc_qei_regs.vh"
 OUT_FIELDS = TOP / "rtl" / "enc_qei_regs_fields.vh"
+OUT_CHFIELDS = TOP / "rtl" / "enc_qei_chan_fields.vh"
 OUT_PARAMS = TOP / "rtl" / "enc_params.vh"
 OUT_TABLE = TOP / "formal" / "enc_qei_regs_table.vh"
 OUT_H = TOP / "sw" / "enc_qei_regs.h"
@@ -36,7 +38,8 @@ def generate(out_dir: Path | None = None) -> dict[Path, Path]:
     """Write every output; with out_dir, into it instead of the tree. Returns {tree path: written}."""
     top = compile_rdl()
     texts = {OUT_V: lambda: regblock.render(top), OUT_VH: lambda: regs_vh.render(top),
-             OUT_FIELDS: lambda: bundle.render_fields(top), OUT_PARAMS: params_vh.render,
+             OUT_FIELDS: lambda: bundle.render_fields("glb"),
+             OUT_CHFIELDS: lambda: bundle.render_fields("chan"), OUT_PARAMS: params_vh.render,
              OUT_TABLE: lambda: regs_table.render(top)}
     files = {OUT_H: lambda p: c_header.c_header(top, p), OUT_MD: lambda p: markdown.markdown(top, p)}
     written = {}

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-"""rtl/enc_params.vh: one elaboration guard per ranged parameter, from the ranges in enc_ip.core.
+"""rtl/enc_params.vh: one elaboration guard per ranged parameter, from the ranges in enc_ip.core,
+and the build constants a module header needs (ADDR_W's default, a channel's bundle widths).
 
 `ENC_CHECK_<NAME>` expands, inside a module's generate region, to a generate `if` that stops
 elaboration when the parameter is out of its range, with a message that names the parameter and
@@ -39,5 +40,29 @@ def render() -> str:
         cond, _, msg = guard(r)
         lines.append(f"`define ENC_CHECK_{r.name} if {cond} begin : g_bad_{r.name.lower()} "
                      f'$error("{msg}"); end')
-    lines += ["`endif", "`endif", ""]
+    lines.append("`endif")
+    lines += addr_w_default(ranges["CHANNELS"].hi)
+    lines += bundle_widths()
+    lines += ["`endif", ""]
     return "\n".join(lines)
+
+
+def bundle_widths() -> list[str]:
+    """The widths of one channel's register bundles, for port declarations (enc_qei_channel),
+    which come before a module body could include enc_qei_regs.vh."""
+    from .bundle import build
+
+    c = build("chan")
+    return ["// One channel's register bundles (rtl/enc_qei_chan_fields.vh): reg2hw and hw2reg widths",
+            f"`define ENC_QEI_R2H_CH_W {c.r2h_w}", f"`define ENC_QEI_H2R_CH_W {c.h2r_w}"]
+
+
+def addr_w_default(channels_max: int) -> list[str]:
+    """`ENC_QEI_ADDR_W(CHANNELS)`: the least address width that holds CHANNELS pages of 256
+    bytes, 8 + ceil(log2(CHANNELS)): the default of ADDR_W in enc_qei and its bus adapters."""
+    expr, bits = "8", 0
+    while (1 << bits) < channels_max:
+        bits += 1
+        expr = f"((CH) > {1 << (bits - 1)}) ? {8 + bits} : ({expr})"
+    return ["// The least byte-address width that holds CHANNELS pages of 256 bytes (the default of ADDR_W)",
+            f"`define ENC_QEI_ADDR_W(CH) ({expr})"]
