@@ -9,11 +9,15 @@ members); helpers pack and unpack register words by field and enum member names.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+import json
+import os
+from dataclasses import asdict, dataclass
 from functools import lru_cache
+from importlib import metadata
 from pathlib import Path
 
-from .paths import RDL
+from .paths import RDL, SIM
 
 
 @lru_cache(maxsize=None)
@@ -83,7 +87,29 @@ class Reg:
 
 @lru_cache(maxsize=None)
 def regmap() -> dict[str, Reg]:
-    """Registers by name, in address order."""
+    """Registers by name, in address order. Kept in sim/build/ (keyed by the RDL, this reader and
+    the compiler's version), so that a process that only reads the map (a simulation's Python)
+    does not load the compiler."""
+    key = hashlib.sha256(RDL.read_bytes() + Path(__file__).read_bytes()
+                         + metadata.version("systemrdl-compiler").encode()).hexdigest()[:16]
+    cache = SIM / "build" / f"regmap-{key}.json"
+    try:
+        return {r["name"]: Reg(r["name"], r["offset"], r["feature"],
+                               {f["name"]: Field(**f) for f in r["fields"]})
+                for r in json.loads(cache.read_text())}
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    regs = _compile_regmap()
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    tmp = cache.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text(json.dumps([dict(name=r.name, offset=r.offset, feature=r.feature,
+                                    fields=[asdict(f) for f in r.fields.values()])
+                               for r in regs.values()]))
+    os.replace(tmp, cache)  # atomic: parallel processes may write it at once
+    return regs
+
+
+def _compile_regmap() -> dict[str, Reg]:
     regs = {}
     for r in compile_rdl().registers():
         fields = {}
