@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import cocotb
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
 from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
@@ -320,6 +320,108 @@ async def wb_abandoned_cycle(dut):
                 f"ACK/ERR {k} clocks after the master dropped CYC"
             await FallingEdge(dut.clk)
         assert await bus.rd("ID") == ident
+
+
+@cocotb_test()
+async def count_hi_lanes_keep_staged_word(dut):
+    """COUNT_HI written in full, then with some byte lanes: the lanes not enabled keep the bytes
+    of the word staged by the first write, not those of the high word a COUNT_LO read latched
+    before; COUNT_LO then loads {the staged word, its word} (COUNT_W 64). With COUNT_W <= 32 the
+    high word is absent: COUNT_HI reads 0 and the count is the COUNT_LO word."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, en=0)
+    # (the AXI4-Lite master writes contiguous lanes only)
+    masks = ([5, 9, 10, 13, 11] if bus.kind == "wb" else []) + [1, 2, 4, 8, 3, 6, 12, 7, 14]
+    latched, w1, w2 = 0x1122_3344, 0xA5B6_C7D8, 0x5A69_7887  # every byte differs between them
+    for k, strb in enumerate(masks):
+        lanes = sum(0xFF << 8 * j for j in range(4) if strb >> j & 1)
+        lo = 0x0BAD_F000 + k
+        await bus.set_count(latched << 32 | 0x600D_0000)
+        assert await bus.rd("COUNT_LO") == 0x600D_0000  # latches COUNT_HI
+        assert await bus.rd("COUNT_HI") == latched & size_mask("COUNT_W:1", env.count_w, 32)
+        await bus.wr("COUNT_HI", w1)
+        await bus.wr("COUNT_HI", w2, strb)
+        await bus.wr("COUNT_LO", lo)
+        exp = ((w1 & ~lanes | w2 & lanes) << 32 | lo) & model.max
+        got = await bus.count()
+        assert got == exp, \
+            f"COUNT_HI {w1:#010x}, then {w2:#010x} strb {strb:#x}, COUNT_LO {lo:#010x}: count " \
+            f"{got:#x}, expected {exp:#x} (COUNT_HI latched {latched:#010x} by a read before)"
+
+
+@cocotb_test()
+async def wb_abandoned_request(dut):
+    """Wishbone: a master that abandons a request (drops CYC after the request was taken, before
+    a clock edge took its answer: 1 or 2 clocks after) and starts a new one 1 or 2 clocks later
+    gets the new request's own answer (ACK or ERR) and data, and no other answer; an abandoned
+    write has been carried out (the new request reads it back).
+    Driven on the raw signals (cocotbext's master cannot abort). (AXI4-Lite: nothing to do.)"""
+    env, rng = await begin(dut)
+    bus = env.bus
+    if bus.kind != "wb":
+        return
+    ident, caps = await bus.rd("ID"), await bus.rd("CAPS")
+    unmapped = max(r.offset for r in regmap().values()) + 4
+
+    async def request(we, adr, data):
+        """Drive a request at the next falling edge (CYC, STB and the request's signals)."""
+        await FallingEdge(dut.clk)
+        dut.wb_adr_i.value, dut.wb_we_i.value, dut.wb_dat_i.value = adr, we, data
+        dut.wb_sel_i.value = 0xF
+        dut.wb_cyc_i.value = dut.wb_stb_i.value = 1
+
+    def answered():
+        return int(dut.wb_ack_o.value) or int(dut.wb_err_o.value)
+
+    for gap in (1, 2):
+        for hold in (1, 2):
+            v = 0x3C5A_0000 | gap << 8 | hold
+            # (what, abandoned request, new request: (we, adr, data), the new one's answer: (err,
+            # data read), the registers written by either, to read back afterwards)
+            cases = (
+                ("read ID, then read CAPS", (0, addr("ID"), 0), (0, addr("CAPS"), 0), (0, caps), {}),
+                ("read unmapped, then read ID", (0, unmapped, 0), (0, addr("ID"), 0), (0, ident), {}),
+                ("read ID, then read unmapped", (0, addr("ID"), 0), (0, unmapped, 0), (1, 0), {}),
+                ("write PRESET_LO, then read it", (1, addr("PRESET_LO"), v), (0, addr("PRESET_LO"), 0),
+                 (0, v), {"PRESET_LO": v}),
+                ("write COMPARE_LO, then write PRESET_LO", (1, addr("COMPARE_LO"), v ^ 0xFF0000),
+                 (1, addr("PRESET_LO"), v ^ 0xFF), (0, None),
+                 {"COMPARE_LO": v ^ 0xFF0000, "PRESET_LO": v ^ 0xFF}),
+                ("write unmapped, then write COMPARE_LO", (1, unmapped, 0), (1, addr("COMPARE_LO"), v),
+                 (0, None), {"COMPARE_LO": v}),
+            )
+            for what, first, second, exp, written in cases:
+                what = f"{what} (held {hold}, CYC low {gap} clocks)"
+                await request(*first)
+                for k in range(hold):  # (held 2: the answer shows in the clock CYC drops)
+                    await FallingEdge(dut.clk)
+                    assert k == hold - 1 or not answered(), f"{what}: answered before CYC dropped"
+                dut.wb_cyc_i.value = dut.wb_stb_i.value = 0
+                for k in range(gap - 1):
+                    await FallingEdge(dut.clk)
+                await request(*second)
+                await ReadOnly()  # an answer may show at once (taken at the next rising edge)
+                for n in range(20):
+                    if answered():
+                        break
+                    await FallingEdge(dut.clk)
+                else:
+                    raise AssertionError(f"{what}: the new request got no answer in 20 clocks")
+                err, data = int(dut.wb_err_o.value), int(dut.wb_dat_o.value)
+                await FallingEdge(dut.clk)
+                dut.wb_stb_i.value = dut.wb_we_i.value = 0  # CYC stays: no other answer may come
+                for k in range(4):
+                    await FallingEdge(dut.clk)
+                    assert not answered(), f"{what}: another answer {k + 1} clocks after the first"
+                dut.wb_cyc_i.value = 0
+                assert err == exp[0], f"{what}: the new request answered {'ERR' if err else 'ACK'}"
+                if second[0] == 0:
+                    assert data == exp[1], f"{what}: the new request read {data:#x}, expected {exp[1]:#x}"
+                for reg, value in written.items():
+                    got = await bus.rd(reg)
+                    assert got == value, f"{what}: {reg} reads {got:#x}, written {value:#x}"
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from hedsmodel import QUAD, random_walk, walk
 from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations
+from enctools.qei.stimulus import durations, play_clocks
 from enctools.regmap import event_bits, pack
 from enctools.tb import cocotb_test
 
@@ -162,6 +162,61 @@ async def error_counters_wide(dut):
     await env.settle(10)
     assert await bus.rd("GLITCH_COUNT") == n, "GLITCH_COUNT after 1,100 lone pulses"
     await bus.events()
+
+
+@cocotb_test()
+async def cmp_on_load(dut):
+    """A COUNT load that makes the count equal COMPARE raises CMP and pulses cmp_out once, for one
+    clock: a COUNT write and an index preset, from another count and from COMPARE itself (the
+    count already had the value), with CTRL.EN = 1 and 0; a load of another value raises neither.
+    COUNT and EVENTS as the model's, cmp_out pulses = the model's compare hits."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    cmp = 0x0000_0005_89AB_CDEF & model.max
+    high = []  # the clocks in which cmp_out is high
+
+    async def watch():
+        n = 0
+        while True:
+            await RisingEdge(dut.clk)
+            n += 1
+            if dut.cmp_out.value == 1:
+                high.append(n)
+
+    mon = cocotb.start_soon(watch())
+    for en in (1, 0):
+        await env.setup(model, count=cmp - 7, compare=cmp, filter_len=1, en=en)
+        await bus.set64("PRESET", cmp)
+        model.preset = cmp
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+        model.idx_gate, model.idx_arm = None, True
+        # (load, count before it, value written: None for an index preset of PRESET = COMPARE)
+        for load, before, value in (("write", cmp - 1, cmp), ("write", cmp, cmp),
+                                    ("write", cmp + 1, cmp + 2), ("preset", cmp + 1, None),
+                                    ("preset", cmp, None)):
+            await bus.set_count(before)
+            model.write_count(before)
+            await env.settle(4)
+            await env.check(model, f"EN {en}: COUNT write of {before:#x}")
+            del high[:]
+            hits = model.cmp_hits
+            if value is not None:
+                await bus.set_count(value)
+                model.write_count(value)
+            else:  # an index pulse (FILTER_LEN 1: Z high for 3 clocks)
+                await play_clocks(env, model, [(env.pos, 1)] * 3 + [(env.pos, 0)])
+            await env.settle()
+            what = f"EN {en}: {load} to {model.count:#x} from {before:#x}, COMPARE {cmp:#x}"
+            await env.check(model, what)
+            pulses = [n for n in high if n - 1 not in high]
+            assert len(pulses) == model.cmp_hits - hits, \
+                f"{what}: {len(pulses)} cmp_out pulses, model {model.cmp_hits - hits}"
+            assert len(high) == len(pulses), f"{what}: cmp_out high longer than one clock"
+        await bus.wr("INDEX_CTRL", 0)
+        model.idx_action = "none"
+    mon.cancel()
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

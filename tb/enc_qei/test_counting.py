@@ -16,7 +16,7 @@ from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitch
 from enctools.qei.bus import T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
 from enctools.qei.model import FUNCS, QeiModel
-from enctools.qei.stimulus import BURST, ceilings, near, steps_from, walk_with_jumps
+from enctools.qei.stimulus import BURST, ceilings, durations, near, steps_from, walk_with_jumps
 from enctools.regmap import get_field, pack, regmap
 from enctools.tb import cocotb_test
 
@@ -236,6 +236,47 @@ async def steps_in_consecutive_clocks(dut):
                 await env.check(model, what)
                 stopped = get_field("STATUS", "STOPPED", await bus.rd("STATUS"))
                 assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb_test()
+async def en_off_gates_steps_only(dut):
+    """CTRL.EN = 0 gates count steps only: steps leave COUNT as it is (no event of theirs), a COUNT
+    write loads, an armed index preset loads PRESET and, one-shot, disarms (INDEX_CTRL.ARM and
+    STATUS.INDEX_ARMED read 0; the next index pulse loads nothing). COUNT and EVENTS as the
+    model's after each part."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    zf = lambda p: int(5 <= p % 40 <= 7)  # noqa: E731  an index pulse over positions 5..7 of 40
+    await env.setup(model, count=1000, en=0)
+    wf = walk([1] * 13 + [-1] * 4, durations(rng, 17), start_pos=env.pos)  # no index pulse
+    await env.play(wf, model)
+    await env.check(model, "EN 0, steps")
+    value = 0x0000_0003_C3A5_5A3C & model.max
+    await bus.set_count(value)
+    model.write_count(value)
+    await env.settle()
+    await env.check(model, "EN 0, COUNT write")
+    preset = 0x0000_0001_2345_6789 & model.max
+    await bus.set64("PRESET", preset)
+    model.preset = preset
+    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", ONESHOT=1, EDGE="rising", ARM=1))
+    model.idx_action, model.idx_oneshot, model.idx_edge = "preset", True, "rising"
+    model.idx_gate, model.idx_arm = None, True
+    for k in range(2):  # forward over one index pulse: it presets; the second one does not
+        wf = walk([1] * 40, durations(rng, 40), start_pos=env.pos)
+        await env.play(wf, model, zfun=zf)
+        assert model.idx_hits == k + 1
+        await env.check(model, f"EN 0, index pulse {k + 1} of a one-shot preset")
+        arm = get_field("INDEX_CTRL", "ARM", await bus.rd("INDEX_CTRL"))
+        armed = get_field("STATUS", "INDEX_ARMED", await bus.rd("STATUS"))
+        assert arm == armed == 0, \
+            f"EN 0: INDEX_CTRL.ARM {arm}, STATUS.INDEX_ARMED {armed} after a one-shot preset"
+        value = (value + 0x111) & model.max
+        await bus.set_count(value)
+        model.write_count(value)
+        await env.settle()
+        await env.check(model, f"EN 0, COUNT write after index pulse {k + 1}")
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge, Timer
 from hedsmodel import QUAD, walk
 
-from enctools.qei.bus import PERIOD_PS
+from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import WIDE, ceilings, durations, near, play_clocks, step_clocks
@@ -264,6 +264,95 @@ async def probe_time_exact(dut):
             f"PROBE_TIME {t:#x} outside {before:#x}..{after:#x}"
         assert latch == value, f"PROBE_LATCH {latch:#x}, count {value:#x}"
         await bus.wr("PROBE_CTRL", 0)
+
+
+# ---- configuration changes are not index edges --------------------------------------------------
+def _gate_state(option, ab, value):
+    """The (A, B) state the index gate compares, for raw state ab with CTRL.<option> = value."""
+    a, b = ab
+    if option == "SWAP_AB" and value:
+        a, b = b, a
+    if option == "INV_A":
+        a ^= value
+    if option == "INV_B":
+        b ^= value
+    return a, b
+
+
+@cocotb_test()
+async def ctrl_change_is_not_an_index_edge(dut):
+    """A CTRL write that changes INV_Z (Z steady, low or high), or SWAP_AB / INV_A / INV_B with the
+    index gate on (Z high: the A/B state the gate compares enters or leaves the gate's), changes
+    the qualified index level the way the armed EDGE acts on: no INDEX event and no action (an
+    armed preset loads nothing, a latch keeps its value), for either EDGE. A real Z edge right
+    after still acts (preset: COUNT = PRESET; latch: INDEX_LATCH = the count)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)  # state (1, 0): A != B
+    ab = QUAD[env.pos % 4]
+    preset = 0x0000_0007_5A5A_0123 & model.max
+    await bus.set64("PRESET", preset)
+
+    async def latch():
+        return await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+
+    def ctrl(option, value):
+        return pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, **{option: value})
+
+    cases = [("INV_Z", z, edge, action) for z in (0, 1) for edge in ("rising", "falling")
+             for action in ("preset", "latch")]
+    cases += [(option, 1, edge, action) for option in ("SWAP_AB", "INV_A", "INV_B")
+              for edge in ("rising", "falling") for action in ("preset", "latch")]
+    for k, (option, z, edge, action) in enumerate(cases):
+        before = int(edge == "falling")  # the qualified index level before the change
+        if option == "INV_Z":  # Z ^ INV_Z goes from `before` to the other level
+            v0, gate = z ^ before, None
+        else:  # in the gate after the change (rising) or before it (falling)
+            v0, gate = 0, _gate_state(option, ab, before ^ 1)
+        what = f"{option} {v0} -> {1 - v0} (Z {z}, {action} on the {edge} edge" + \
+            (f", gate {gate})" if gate else ")")
+        await bus.wr("INDEX_CTRL", 0)
+        dut.z_in.value = z
+        await bus.wr("CTRL", ctrl(option, v0))
+        count = 0x100 + 0x10 * k
+        await bus.set_count(count)
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE=edge, ARM=1,
+                                        GATE_EN=int(gate is not None), GATE_A=gate[0] if gate else 0,
+                                        GATE_B=gate[1] if gate else 0))
+        await env.settle(4)
+        held = await latch()
+        await bus.events()
+        await bus.wr("CTRL", ctrl(option, 1 - v0))
+        await env.settle(4)
+        ev = await bus.events()
+        assert "INDEX" not in ev, f"{what}: the CTRL write raised INDEX ({sorted(ev)})"
+        got = await bus.count()
+        assert got == count, f"{what}: the CTRL write changed COUNT to {got:#x} (was {count:#x})"
+        got = await latch()
+        assert got == held, f"{what}: the CTRL write changed INDEX_LATCH to {got:#x} (was {held:#x})"
+        # a real Z edge right after: a pulse of Z makes one edge of the armed type (with the gate
+        # and the falling edge, back into the gate first: no edge either)
+        count2 = count + 5
+        await bus.set_count(count2)
+        if gate is not None and edge == "falling":
+            await bus.wr("CTRL", ctrl(option, v0))
+        await FallingEdge(dut.clk)
+        dut.z_in.value = 1 - z
+        await ClockCycles(dut.clk, 3)
+        await FallingEdge(dut.clk)
+        dut.z_in.value = z
+        await env.settle(6)
+        ev = await bus.events()
+        assert "INDEX" in ev, f"{what}: no INDEX event from the Z edge after the CTRL write"
+        if action == "preset":
+            got = await bus.count()
+            assert got == preset, f"{what}: COUNT {got:#x} after the Z edge, PRESET {preset:#x}"
+        else:
+            got = await latch()
+            assert got == count2, f"{what}: INDEX_LATCH {got:#x} after the Z edge, count {count2:#x}"
+    await bus.wr("INDEX_CTRL", 0)
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
