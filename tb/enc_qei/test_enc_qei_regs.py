@@ -2,7 +2,7 @@
 """The register map's generated outputs: committed files match rtl/enc_qei.rdl (and a stale one is
 caught), the C header compiles cleanly and agrees with the RDL, and the RDL keeps the contract's
 names (registers, fields, enum members). The register walk through the bus is the cocotb test
-register_walk in test_enc_qei.py."""
+register_walk in test_bus.py."""
 
 from __future__ import annotations
 

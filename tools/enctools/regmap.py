@@ -14,11 +14,15 @@ revision (one flat map) reads as one page of channel registers.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+import json
+import os
+from dataclasses import asdict, dataclass
 from functools import lru_cache
+from importlib import metadata
 from pathlib import Path
 
-from .paths import RDL
+from .paths import RDL, SIM
 
 
 @lru_cache(maxsize=None)
@@ -135,7 +139,30 @@ def channels_max(path: Path = RDL) -> int:
 @lru_cache(maxsize=None)
 def regmap(path: Path = RDL) -> dict[str, Reg]:
     """Registers by name, in page-offset order (``path``: another RDL than rtl/enc_qei.rdl, e.g.
-    the one of a git revision a bench simulates)."""
+    the one of a git revision a bench simulates). Kept in sim/build/ as JSON (keyed by the RDL,
+    this reader and the compiler's version), so that a process that only reads the map (a
+    simulation's Python) does not load the compiler."""
+    path = Path(path)
+    key = hashlib.sha256(path.read_bytes() + Path(__file__).read_bytes()
+                         + metadata.version("systemrdl-compiler").encode()).hexdigest()[:16]
+    cache = SIM / "build" / f"regmap-{key}.json"
+    try:
+        return {r["name"]: Reg(r["name"], r["offset"], r["feature"],
+                               {f["name"]: Field(**f) for f in r["fields"]}, r["group"])
+                for r in json.loads(cache.read_text())}
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    regs = _compile_regmap(path)
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    tmp = cache.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text(json.dumps([dict(name=r.name, offset=r.offset, feature=r.feature,
+                                    group=r.group, fields=[asdict(f) for f in r.fields.values()])
+                               for r in regs.values()]))
+    os.replace(tmp, cache)  # atomic: parallel processes may write it at once
+    return regs
+
+
+def _compile_regmap(path: Path) -> dict[str, Reg]:
     regs = {}
     for group, offset, r in nodes(path):
         fields = {}

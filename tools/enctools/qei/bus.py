@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The bus of the enc_qei tests: one object over the ecosystem's masters (cocotbext-wishbone
 WishboneMaster or cocotbext-axi AxiLiteMaster with random back-pressure on every channel), with
-register access by name (the register map is enctools.regmap), and clock-exact stimulus."""
+register access by name (the register map is enctools.regmap). Clock-exact stimulus is in
+enctools.qei.stimulus."""
 
 from __future__ import annotations
 
@@ -121,35 +122,3 @@ class QeiBus:
             await self.wr("EVENTS", word)
         return event_names(word)
 
-
-# ---- clock-exact stimulus ---------------------------------------------------------------------------
-async def play_clocks(env, model, clocks) -> None:
-    """Drive (A, B) and Z clock by clock: ``clocks`` lists (4X position, Z level) per clock, set at
-    the falling edge before that clock's rising edge, so that with FILTER_LEN 1 (a level of one
-    clock is kept) each change is sampled in exactly that clock: steps in consecutive clocks, an
-    index edge in the clock of a step or right before one. Every change of (A, B) or Z is one
-    sample of the model (qei_model.QeiModel.sample), in order. ``env`` is the test environment (its
-    ``pos`` is kept; ``z`` is the Z level now)."""
-    from cocotb.triggers import FallingEdge
-    from enctools.qei.model import QUAD
-
-    dut = env.dut
-    prev = (env.pos % 4, getattr(env, "z", 0))
-    for pos, z in clocks:
-        await FallingEdge(dut.clk)
-        dut.a_in.value, dut.b_in.value = QUAD[pos % 4]
-        dut.z_in.value = z
-        if (pos % 4, z) != prev and model is not None:
-            model.sample(QUAD[pos % 4], z)
-        prev = (pos % 4, z)
-        env.pos, env.z = pos, z
-
-
-def step_clocks(pos: int, steps, z=None) -> list:
-    """(position, Z) per clock for ``steps`` (+1, -1 or 0 per clock) from 4X position ``pos``;
-    ``z``: the Z level per clock (default 0)."""
-    out = []
-    for i, s in enumerate(steps):
-        pos += s
-        out.append((pos, z[i] if z is not None else 0))
-    return out

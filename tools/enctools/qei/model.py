@@ -10,9 +10,14 @@ and the events raised since :meth:`take_events`.
 
 from __future__ import annotations
 
-FUNCS = ("x4", "x2a", "x2b", "x1a", "x1b", "pulse_dir", "increase", "decrease", "x1_hyst")
-RANGES = ("free", "modulo", "limit", "non_recycle")
+from enctools.regmap import enum_names
+
+# the names of the count functions and range modes (rtl/enc_qei.rdl's enums, in code order); what
+# each one does is written below from the contract
+FUNCS = enum_names("CTRL", "FUNC")
+RANGES = enum_names("CTRL", "RANGE")
 QUAD_FUNCS = ("x4", "x2a", "x2b", "x1a", "x1b", "x1_hyst")
+EDGE_FUNCS = ("pulse_dir", "increase", "decrease")  # count on A rising edges
 QUAD = ((0, 0), (1, 0), (1, 1), (0, 1))  # forward sequence (A leads B)
 POS = {ab: p for p, ab in enumerate(QUAD)}
 
@@ -56,6 +61,8 @@ class QeiModel:
     # ---- configuration -------------------------------------------------------------------------
     def set_func(self, func: str, state) -> None:
         """A FUNC change re-references the decoders at the present state."""
+        if func not in QUAD_FUNCS + EDGE_FUNCS:
+            raise ValueError(f"QeiModel: count function {func!r} has no model")
         self.func = func
         self.reference(state)
 

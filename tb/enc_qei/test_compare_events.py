@@ -1,0 +1,225 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei compare, events and irq: COMPARE and cmp_out, every event set, masked, enabled onto
+irq and cleared by W1C, the error counters (QERR_COUNT, GLITCH_COUNT), CMP on count loads.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import cocotb
+import pytest
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from hedsmodel import QUAD, random_walk, walk
+
+from enctools.qei.bus import PERIOD_PS, T_NS
+from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
+from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import durations, play_clocks
+from enctools.regmap import event_bits, pack
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def compare(dut):
+    """COMPARE: the CMP event and one cmp_out pulse each time the count changes to it."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    pulses = 0
+
+    async def count_pulses():
+        nonlocal pulses
+        while True:
+            await RisingEdge(dut.clk)
+            if dut.cmp_out.value == 1:
+                pulses += 1
+                await RisingEdge(dut.clk)
+                assert dut.cmp_out.value == 0, "cmp_out is longer than one clock"
+                pulses += 0
+
+    await env.setup(model, count=100, compare=104)
+    model.cmp_hits = 0
+    mon = cocotb.start_soon(count_pulses())
+    steps = ([1] * 8 + [-1] * 8) * 3 + [1] * 4 + [-1, 1] * 5
+    wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
+    await env.play(wf, model)
+    wf = random_walk(rng, 200, 1.05 * FILTER * T_NS + 0.1, 3 * FILTER * T_NS, p_reverse=0.4,
+                     start_pos=env.pos)
+    await env.play(wf, model)
+    await env.check(model, "compare walk")
+    mon.cancel()
+    assert pulses == model.cmp_hits, f"cmp_out pulsed {pulses} times, model {model.cmp_hits}"
+    assert pulses >= 2, "the walk never reached COMPARE"
+
+
+@cocotb_test()
+async def events_and_irq(dut):
+    """Every count-side event: set, masked, enabled onto irq, cleared alone by W1C."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=model.max, compare=2, filter_len=3)
+    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none"))
+    await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1))
+
+    async def make(name):
+        if name == "OVERFLOW":
+            await bus.set_count(model.max)
+            await env.play(walk([1], [45.0], start_pos=env.pos), None)
+        elif name == "UNDERFLOW":
+            await bus.set_count(0)
+            await env.play(walk([-1], [45.0], start_pos=env.pos), None)
+        elif name == "DIR_CHANGE":
+            await env.play(walk([1, -1], [45.0, 45.0], start_pos=env.pos), None)
+        elif name == "CMP":
+            await bus.set_count(2)
+        elif name == "QERR":
+            await env.play(walk([2], [45.0], start_pos=env.pos), None)
+        elif name == "GLITCH":
+            dut.a_in.value = 1 - QUAD[env.pos % 4][0]
+            await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")  # 1 or 2 samples < FILTER_LEN 3
+            dut.a_in.value = QUAD[env.pos % 4][0]
+        elif name == "INDEX":
+            dut.z_in.value = 1
+            await env.settle(8)
+            dut.z_in.value = 0
+        elif name == "PROBE":
+            dut.probe_in.value = 1
+            await env.settle(8)
+            dut.probe_in.value = 0
+        elif name == "SNAP_READY":
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+        elif name == "PERIOD_READY":
+            await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, N=1))
+            await env.play(walk([1, 1], [45.0, 45.0], start_pos=env.pos), None)
+            await bus.wr("PERIOD_CTRL", 0)
+        elif name == "STALL":
+            await bus.wr("STALL_TIMEOUT", 20)
+            await env.settle(30)
+            await bus.wr("STALL_TIMEOUT", 0)
+        await env.settle()
+
+    names = ["OVERFLOW", "UNDERFLOW", "DIR_CHANGE", "CMP", "QERR", "GLITCH", "INDEX", "PROBE",
+             "SNAP_READY", "PERIOD_READY", "STALL"]
+    for name in names:
+        await bus.wr("IRQ_EN", 0)
+        await bus.events()
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=3))
+        await make(name)
+        word = await bus.rd("EVENTS")
+        assert word & event_bits(name), f"{name} not raised (EVENTS {word:#x})"
+        await env.settle(3)
+        assert dut.irq.value == 0, f"irq high with IRQ_EN = 0 ({name})"
+        await bus.wr("IRQ_EN", event_bits(*(n for n in names if n != name)) & ~word)
+        await env.settle(3)
+        assert dut.irq.value == 0, f"irq high with {name} masked"
+        await bus.wr("IRQ_EN", event_bits(name))
+        await env.settle(3)
+        assert dut.irq.value == 1, f"irq low with {name} pending and enabled"
+        # set a second event, then clear only the first: the second stays
+        other = "CMP" if name != "CMP" else "INDEX"
+        await make(other)
+        both = await bus.rd("EVENTS")
+        assert both & event_bits(other), f"{other} not raised"
+        await bus.wr("EVENTS", event_bits(name))
+        after = await bus.rd("EVENTS")
+        assert not after & event_bits(name), f"W1C did not clear {name}"
+        assert after & event_bits(other), f"W1C of {name} also cleared {other}"
+        await env.settle(3)
+        assert dut.irq.value == 0, f"irq still high after clearing {name}"
+        await bus.wr("EVENTS", 0)  # writing 0 clears nothing
+        assert await bus.rd("EVENTS") == after
+        if name in ("OVERFLOW",):
+            model.count = 0
+    assert await bus.rd("GLITCH_COUNT") >= 1
+
+
+@cocotb_test()
+async def error_counters_wide(dut):
+    """QERR_COUNT and GLITCH_COUNT past 1,024 (bits 10 and up): 1,100 illegal jumps and 1,100
+    lone one-clock pulses are each counted."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    n = 1100
+    await env.setup(model, func="x4", filter_len=1, count=0)
+    await env.drv.play(walk([2] * n, [3 * T_NS] * n, start_pos=env.pos))
+    env.pos += 2 * n
+    await env.settle(10)
+    assert await bus.rd("QERR_COUNT") == n, "QERR_COUNT after 1,100 illegal jumps"
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=2))
+    await env.settle(10)
+    await bus.wr("GLITCH_COUNT", 0)
+    a = QUAD[env.pos % 4][0]
+    for _ in range(n):
+        await FallingEdge(dut.clk)
+        dut.a_in.value = 1 - a
+        await FallingEdge(dut.clk)
+        dut.a_in.value = a
+        await ClockCycles(dut.clk, 2)
+    await env.settle(10)
+    assert await bus.rd("GLITCH_COUNT") == n, "GLITCH_COUNT after 1,100 lone pulses"
+    await bus.events()
+
+
+@cocotb_test()
+async def cmp_on_load(dut):
+    """A COUNT load that makes the count equal COMPARE raises CMP and pulses cmp_out once, for one
+    clock: a COUNT write and an index preset, from another count and from COMPARE itself (the
+    count already had the value), with CTRL.EN = 1 and 0; a load of another value raises neither.
+    COUNT and EVENTS as the model's, cmp_out pulses = the model's compare hits."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    cmp = 0x0000_0005_89AB_CDEF & model.max
+    high = []  # the clocks in which cmp_out is high
+
+    async def watch():
+        n = 0
+        while True:
+            await RisingEdge(dut.clk)
+            n += 1
+            if dut.cmp_out.value == 1:
+                high.append(n)
+
+    mon = cocotb.start_soon(watch())
+    for en in (1, 0):
+        await env.setup(model, count=cmp - 7, compare=cmp, filter_len=1, en=en)
+        await bus.set64("PRESET", cmp)
+        model.preset = cmp
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+        model.idx_gate, model.idx_arm = None, True
+        # (load, count before it, value written: None for an index preset of PRESET = COMPARE)
+        for load, before, value in (("write", cmp - 1, cmp), ("write", cmp, cmp),
+                                    ("write", cmp + 1, cmp + 2), ("preset", cmp + 1, None),
+                                    ("preset", cmp, None)):
+            await bus.set_count(before)
+            model.write_count(before)
+            await env.settle(4)
+            await env.check(model, f"EN {en}: COUNT write of {before:#x}")
+            del high[:]
+            hits = model.cmp_hits
+            if value is not None:
+                await bus.set_count(value)
+                model.write_count(value)
+            else:  # an index pulse (FILTER_LEN 1: Z high for 3 clocks)
+                await play_clocks(env, model, [(env.pos, 1)] * 3 + [(env.pos, 0)])
+            await env.settle()
+            what = f"EN {en}: {load} to {model.count:#x} from {before:#x}, COMPARE {cmp:#x}"
+            await env.check(model, what)
+            pulses = [n for n in high if n - 1 not in high]
+            assert len(pulses) == model.cmp_hits - hits, \
+                f"{what}: {len(pulses)} cmp_out pulses, model {model.cmp_hits - hits}"
+            assert len(high) == len(pulses), f"{what}: cmp_out high longer than one clock"
+        await bus.wr("INDEX_CTRL", 0)
+        model.idx_action = "none"
+    mon.cancel()
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_compare_events(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

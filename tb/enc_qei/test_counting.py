@@ -1,0 +1,285 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei counting: the count functions against the independent model (enctools.qei.model),
+the input filter, a modelled HEDS-5000 unit, the count beyond the rate rule, the channel options
+(SWAP_AB, INV_A, INV_B), steps in consecutive clocks, and CTRL.EN.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import pytest
+from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
+
+from enctools.qei.bus import T_NS
+from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
+from enctools.qei.model import FUNCS, QeiModel
+from enctools.qei.stimulus import BURST, ceilings, durations, near, steps_from, walk_with_jumps
+from enctools.regmap import get_field, pack, regmap
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def func_walks(dut):
+    """Every CTRL.FUNC against the model: long random walks, dither, illegal jumps."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    for func in FUNCS:
+        start_count = rng.choice([0, 5, model.max - 3, rng.getrandbits(env.count_w)])
+        compare = (start_count + rng.randint(-3, 3)) & model.max
+        await env.setup(model, func=func, count=start_count, compare=compare)
+        for name, n, p_rev in (("run", 250, 0.05), ("dither", 150, 0.5)):
+            wf = random_walk(rng, n, 1.05 * FILTER * T_NS + 0.1, 3 * FILTER * T_NS, p_reverse=p_rev,
+                             start_pos=env.pos)
+            await env.play(wf, model)
+            await env.check(model, f"{func} {name}")
+        wf = walk_with_jumps(rng, 150, env.pos, jumps=8)
+        await env.play(wf, model)
+        await env.check(model, f"{func} jumps")
+        qerr = await env.bus.rd("QERR_COUNT")
+        assert qerr == model.qerrs, f"{func}: QERR_COUNT {qerr}, model {model.qerrs}"
+        dut._log.info("%s: count %#x, %d quadrature errors", func, model.count, qerr)
+
+
+@cocotb_test()
+async def filter_lengths(dut):
+    """Run-time FILTER_LEN: exact counting at the rate rule, lone pulses rejected and counted."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for f in (1, 3, 7, 16):
+        await env.setup(model, func="x4", filter_len=f, count=rng.getrandbits(16))
+        wf = random_walk(rng, 60, 1.05 * f * T_NS + 0.1, 4 * f * T_NS + 3 * T_NS, p_reverse=0.3,
+                         start_pos=env.pos)
+        if f >= 3:
+            # lone pulses of f - 1.3 clocks (f - 2 or f - 1 samples: always seen, always rejected),
+            # at least f + 1 clocks from any transition (the count-rate rule)
+            wf = with_glitches(wf, rng, 10, (f - 1.3) * T_NS, guard_ns=(f + 1.05) * T_NS)
+        await env.drv.play(wf)
+        # feed the model only the accepted states (a lone pulse returns to the same position)
+        last = QUAD[env.pos % 4]
+        for (_, a, b), p in zip(wf.events[1:], wf.positions[1:]):
+            st = QUAD[p % 4]
+            if st != last:
+                model.sample(st)
+                last = st
+        env.pos = wf.positions[-1]
+        await env.settle(3 * f + 10)
+        got = await bus.count()
+        assert got == model.count, f"FILTER_LEN {f}: count {got}, model {model.count}"
+        glitches = await bus.rd("GLITCH_COUNT")
+        pulses = (len(wf.events) - 61) // 2
+        if f >= 3:
+            assert glitches == pulses, f"FILTER_LEN {f}: GLITCH_COUNT {glitches}, {pulses} pulses"
+        else:
+            assert glitches == 0
+        ev = await bus.events()
+        assert "QERR" not in ev
+        assert ("GLITCH" in ev) == (f >= 3 and pulses > 0)
+        model.take_events()
+
+
+@cocotb_test()
+async def heds_unit_profile(dut):
+    """A modelled HEDS-5000 unit (typical errors) accelerating, reversing and stopping: x4 count
+    equals the model's position, no error flagged. Clock 2 MHz, so states last >= 10 clocks."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, func="x4", count=0)
+    import numpy as np
+
+    unit = EncoderUnit.typical(np.random.default_rng(rng.getrandbits(32)))
+    profile = Profile(start_deg=0).ramp(0, 3000, 0.0015).ramp(3000, -1500, 0.002).stop(0.0003)
+    wf = unit.waveform(profile)
+    # the clock is 100 MHz here: slow the waveform 25x in time so states last >= 10 clocks
+    scale = 25.0
+    from hedsmodel import Waveform
+
+    slow = Waveform()
+    p0 = wf.positions[0]
+    for (t, a, b), p in zip(wf.events, wf.positions):
+        slow.append(t / scale, p, (a, b))
+    assert slow.min_state_ns() > 2.1 * FILTER * T_NS, slow.min_state_ns()
+    # start from the unit's first state: re-reference there
+    first = (wf.events[0][1], wf.events[0][2])
+    dut.a_in.value, dut.b_in.value = first
+    await env.settle(10)
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x1a", FILTER_LEN=FILTER))
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=FILTER))
+    await env.settle(10)
+    await bus.set_count(0)
+    await bus.events()
+    await env.drv.play(slow)
+    await env.settle()
+    got = await bus.count()
+    exp = (wf.positions[-1] - p0) & model.max
+    assert got == exp, f"count {got:#x}, model position change {exp:#x}"
+    ev = await bus.events()
+    assert not ev & {"QERR", "GLITCH"}, f"errors flagged on a clean unit: {ev}"
+    dut._log.info("HEDS-5000 profile: %d transitions, final count %d", len(wf.events) - 1,
+                  got if got < 1 << 31 else got - (1 << env.count_w))
+
+
+@cocotb_test()
+async def beyond_rate_rule(dut):
+    """Outside the count-rate rule (states shorter than a clock, pulses shorter than the filter)
+    the count is exact or QERR / GLITCH is raised: never a silent loss."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    flagged = 0
+    for f in (1, 3):
+        for seg in range(12):
+            await env.setup(model, func="x4", filter_len=f, count=0)
+            wf = random_walk(rng, 80, 0.3 * T_NS, (1.3 * f + 0.5) * T_NS, p_reverse=0.3,
+                             start_pos=env.pos)
+            await env.drv.play(wf)
+            moved = wf.positions[-1] - env.pos
+            env.pos = wf.positions[-1]
+            await env.settle(3 * f + 12)
+            got = await bus.count()
+            ev = await bus.events()
+            exact = got == moved & model.max
+            if not exact:
+                assert ev & {"QERR", "GLITCH"}, \
+                    f"FILTER_LEN {f}: count {got:#x} != position change {moved}, nothing flagged ({ev})"
+                flagged += 1
+            # re-synchronise the model with the position the peripheral now holds
+    assert flagged >= 3, "the stimulus never broke the rule; the test tested nothing"
+    dut._log.info("%d of 24 fast segments miscounted, every one flagged", flagged)
+
+
+@cocotb_test()
+async def filter_len_clamp(dut):
+    """CTRL.FILTER_LEN 0 acts as 1 (states of 1.05 clocks count exactly), 31 as 16 (a level of
+    14.7 clocks is rejected, states of 17.5 .. 70 clocks count exactly)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for f, lo, hi, pulses in ((0, 1.05, 2.0, 0), (31, 17.5, 70.0, 4)):
+        await env.setup(model, func="x4", filter_len=f, count=0)
+        wf = random_walk(rng, 40 if f else 300, lo * T_NS + 0.1, hi * T_NS, p_reverse=0.3,
+                         start_pos=env.pos)
+        n = len(wf.events)
+        if pulses:
+            wf = with_glitches(wf, rng, pulses, 14.7 * T_NS, guard_ns=17.05 * T_NS)
+            pulses = (len(wf.events) - n) // 2
+            assert pulses >= 2
+        await env.drv.play(wf)
+        last = QUAD[env.pos % 4]
+        for (_, a, b), p in zip(wf.events[1:], wf.positions[1:]):
+            st = QUAD[p % 4]
+            if st != last:
+                model.sample(st)
+                last = st
+        env.pos = wf.positions[-1]
+        await env.settle(60)
+        got = await bus.count()
+        assert got == model.count, f"FILTER_LEN {f}: count {got}, model {model.count}"
+        assert await bus.rd("GLITCH_COUNT") == pulses, f"FILTER_LEN {f}: GLITCH_COUNT"
+        ev = await bus.events()
+        assert "QERR" not in ev, f"FILTER_LEN {f}: QERR"
+        model.take_events()
+
+
+@cocotb_test()
+async def swap_and_invert(dut):
+    """CTRL.SWAP_AB, INV_A, INV_B, INV_Z in every combination: STATUS.A/B/Z show the channels as
+    the decoders see them, and a forward walk counts up or down by the parity of the three A/B
+    options (each reverses the direction), with no QERR."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    st = regmap()["STATUS"].fields
+    for combo in range(16):
+        swap, inv_a, inv_b, inv_z = (combo >> 0 & 1, combo >> 1 & 1, combo >> 2 & 1, combo >> 3 & 1)
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=2, SWAP_AB=swap, INV_A=inv_a,
+                                  INV_B=inv_b, INV_Z=inv_z))
+        await env.settle(8)
+        await bus.set_count(0)
+        await bus.events()
+        for k in range(3):
+            a, b = QUAD[env.pos % 4]
+            status = await bus.rd("STATUS")
+            exp = ((b if swap else a) ^ inv_a, (a if swap else b) ^ inv_b, inv_z)
+            got = tuple(status >> st[n].lsb & 1 for n in ("A", "B", "Z"))
+            assert got == exp, f"combo {combo:04b}: STATUS A/B/Z {got}, expected {exp}"
+            steps = [1] * (3 + 2 * k)
+            await env.play(walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos), None)
+        n = 3 + 5 + 7
+        exp_count = (n if (swap + inv_a + inv_b) % 2 == 0 else -n) & ((1 << env.count_w) - 1)
+        got = await bus.count()
+        assert got == exp_count, f"combo {combo:04b}: COUNT {got:#x}, expected {exp_count:#x}"
+        assert "QERR" not in await bus.events(), f"combo {combo:04b}: QERR"
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=3))
+
+
+@cocotb_test()
+async def steps_in_consecutive_clocks(dut):
+    """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
+    and just below CEILING, at 0 and at the top, steps in consecutive clocks both ways (an up step
+    right after a down step, a wrap right after a wrap, ...): COUNT, EVENTS and STATUS.STOPPED
+    equal the model's after each burst."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("modulo", "limit", "non_recycle", "free"):
+        for ceiling in (ceilings(env.count_w) if mode != "free" else [top]):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            starts = near([ceiling + d for d in (-1, 0, 1, 2)] + [0, top], 0, top)
+            for start in starts:
+                await steps_from(env, model, start, BURST)
+                what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks"
+                await env.check(model, what)
+                stopped = get_field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb_test()
+async def en_off_gates_steps_only(dut):
+    """CTRL.EN = 0 gates count steps only: steps leave COUNT as it is (no event of theirs), a COUNT
+    write loads, an armed index preset loads PRESET and, one-shot, disarms (INDEX_CTRL.ARM and
+    STATUS.INDEX_ARMED read 0; the next index pulse loads nothing). COUNT and EVENTS as the
+    model's after each part."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    zf = lambda p: int(5 <= p % 40 <= 7)  # noqa: E731  an index pulse over positions 5..7 of 40
+    await env.setup(model, count=1000, en=0)
+    wf = walk([1] * 13 + [-1] * 4, durations(rng, 17), start_pos=env.pos)  # no index pulse
+    await env.play(wf, model)
+    await env.check(model, "EN 0, steps")
+    value = 0x0000_0003_C3A5_5A3C & model.max
+    await bus.set_count(value)
+    model.write_count(value)
+    await env.settle()
+    await env.check(model, "EN 0, COUNT write")
+    preset = 0x0000_0001_2345_6789 & model.max
+    await bus.set64("PRESET", preset)
+    model.preset = preset
+    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", ONESHOT=1, EDGE="rising", ARM=1))
+    model.idx_action, model.idx_oneshot, model.idx_edge = "preset", True, "rising"
+    model.idx_gate, model.idx_arm = None, True
+    for k in range(2):  # forward over one index pulse: it presets; the second one does not
+        wf = walk([1] * 40, durations(rng, 40), start_pos=env.pos)
+        await env.play(wf, model, zfun=zf)
+        assert model.idx_hits == k + 1
+        await env.check(model, f"EN 0, index pulse {k + 1} of a one-shot preset")
+        arm = get_field("INDEX_CTRL", "ARM", await bus.rd("INDEX_CTRL"))
+        armed = get_field("STATUS", "INDEX_ARMED", await bus.rd("STATUS"))
+        assert arm == armed == 0, \
+            f"EN 0: INDEX_CTRL.ARM {arm}, STATUS.INDEX_ARMED {armed} after a one-shot preset"
+        value = (value + 0x111) & model.max
+        await bus.set_count(value)
+        model.write_count(value)
+        await env.settle()
+        await env.check(model, f"EN 0, COUNT write after index pulse {k + 1}")
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_counting(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

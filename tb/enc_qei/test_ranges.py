@@ -1,0 +1,184 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei range modes (free, modulo, limit, non_recycle) and CEILING: across the bounds both
+ways, CEILINGs with every bit pattern, bounded ranges at the count-rate bound, step pairs and
+bursts of steps in consecutive clocks at the bounds.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+from hedsmodel import random_walk, walk
+
+from enctools.qei.bus import T_NS
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.model import RANGES, QeiModel
+from enctools.qei.stimulus import BURST, WIDE, durations, near, steps_from
+from enctools.regmap import get_field, pack, regmap
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def range_modes(dut):
+    """Each RANGE across its boundaries, both ways; non_recycle stops until COUNT is written."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for mode in RANGES:
+        ceiling = rng.randint(5, 12) if mode != "free" else model.max
+        start_count = 2 if mode != "free" else model.max - 2
+        await env.setup(model, func="x4", rng_mode=mode, count=start_count, ceiling=ceiling)
+        # up across the top, down across 0, up again, in small checked pieces
+        for direction, n in ((1, 20), (-1, 40), (1, 9), (-1, 3), (1, 30)):
+            done = 0
+            while done < n:
+                k = min(n - done, rng.randint(1, 5))
+                wf = walk([direction] * k, durations(rng, k), start_pos=env.pos)
+                await env.play(wf, model)
+                await env.check(model, f"{mode} dir {direction}")
+                status = await bus.rd("STATUS")
+                stopped = status >> regmap()["STATUS"].fields["STOPPED"].lsb & 1
+                assert stopped == int(model.stopped), f"{mode}: STATUS.STOPPED {stopped}"
+                done += k
+            if mode == "non_recycle" and model.stopped:
+                value = rng.randint(1, ceiling - 1)
+                await bus.set_count(value)
+                model.write_count(value)
+                await env.settle()
+                await env.check(model, "non_recycle after COUNT write")
+        dut._log.info("%s ok (ceiling %d)", mode, ceiling)
+
+
+@cocotb_test()
+async def ceiling_wide(dut):
+    """RANGE modulo and limit with CEILINGs of varied bit patterns: across the top both ways, and
+    from counts just above and below it in each 16-bit slice (the slices are compared apart)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    ceilings = WIDE + tuple(~v for v in WIDE[:2])
+    for i, ceiling in enumerate(ceilings):
+        mode = ("modulo", "limit")[i % 2]
+        ceiling &= model.max
+        starts = [ceiling - 2]
+        for sl in range(0, env.count_w, 16):  # one slice above / below, the others equal
+            for d in (1 << sl, -(1 << sl)):
+                c = ceiling + d
+                if 0 <= c <= model.max and c != ceiling:
+                    starts.append(c)
+        for start in starts:
+            await env.setup(model, rng_mode=mode, count=start, ceiling=ceiling)
+            for steps in ([1, 1, 1, 1], [-1, -1, -1, -1, -1]):
+                wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+                await env.play(wf, model)
+                await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}")
+
+
+@cocotb_test()
+async def bounded_range_fast(dut):
+    """RANGE modulo and limit at the count-rate bound (FILTER_LEN 1, states of 1.05 .. 2.1 clocks,
+    many reversals: steps in consecutive clocks both ways), CEILINGs with high bits, counts on
+    both sides of slice boundaries: COUNT and events equal the model's."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for mode, ceiling, start in (("modulo", 0x1_0000_0040, 0x1_0000_0020), ("limit", 0x2_0001_0010, 0x2_0000_FFF8),
+                                 ("modulo", 0x30, 0x2E), ("limit", 0x1_0018, 0xFFF0),
+                                 ("limit", 0xFFF0, 0x1_0008), ("modulo", 0x1_FFF0, 0x2_0004),
+                                 ("modulo", 0, 0), ("limit", 0, 0), ("modulo", 0x8000_8001, 3)):
+        ceiling &= model.max
+        start &= model.max
+        await env.setup(model, rng_mode=mode, filter_len=1, count=start, ceiling=ceiling)
+        wf = random_walk(rng, 600, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
+        await env.play(wf, model)
+        await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x} fast")
+    # index presets near CEILING (in other 16-bit slices too), steps right after them
+    for mode, ceiling, preset in (("limit", 0x0800_1234, 0x0800_1230), ("modulo", 0x0800_1234, 0x0801_0000),
+                                  ("limit", 0x1_0000, 0xFFFF), ("modulo", 0x0C00_0000, 0x0BFF_FFFE)):
+        ceiling &= model.max
+        preset &= model.max
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+        await bus.set64("PRESET", preset)
+        model.preset = preset
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+        model.idx_gate, model.idx_arm = None, True
+        wf = random_walk(rng, 400, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
+        await env.play(wf, model, zfun=lambda p: int(p % 7 == 0))
+        await env.check(model, f"{mode} CEILING {ceiling:#x} PRESET {preset:#x} fast")
+        await bus.wr("INDEX_CTRL", 0)
+        model.idx_action = "none"
+
+
+# the CEILINGs of the step-pair test: 0, 1 (every count but 0 is at it), small, high bits
+def _pair_ceilings(count_w):
+    return [0, 1, 0x8000_8021]
+
+
+@cocotb_test()
+async def step_pairs_at_bounds(dut):
+    """Two steps in consecutive clocks (down-up, up-down, up-up) from counts at, just above and
+    just below CEILING and at 0 / 1, every bounded range, CEILING 0 and 1 too: COUNT, EVENTS and
+    STATUS.STOPPED after each pair (an event missed in one pair cannot hide behind the same event
+    of a later one)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    top = model.max
+    for mode in ("limit", "non_recycle", "modulo"):
+        for ceiling in _pair_ceilings(env.count_w):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            for start in near([ceiling + d for d in (-1, 0, 1, 2)] + [0, 1], 0, top):
+                for pair in ((-1, +1), (+1, -1), (+1, +1)):
+                    await steps_from(env, model, start, pair)
+                    what = f"{mode} CEILING {ceiling:#x} from {start:#x}, steps {pair}"
+                    await env.check(model, what)
+                    stopped = get_field("STATUS", "STOPPED", await bus.rd("STATUS"))
+                    assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
+
+
+@cocotb_test()
+async def steps_at_patterned_ceilings(dut):
+    """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
+    list every run), each range, counts one step and one or five units of a 16-bit slice away:
+    the slice comparators of the at-CEILING flags with every carry pattern, under steps in
+    consecutive clocks (the BURST of steps_in_consecutive_clocks)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    top = model.max
+    pick = random.Random(1414)
+    for i in range(12):
+        mode = ("modulo", "limit", "non_recycle")[i % 3]
+        sl = pick.randrange(0, env.count_w // 16)
+        ceiling = pick.getrandbits(env.count_w) >> pick.randrange(0, env.count_w)
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+        for d in (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl)):
+            start = ceiling + d
+            if not 0 <= start <= top:
+                continue
+            await steps_from(env, model, start, BURST)
+            await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
+
+
+@cocotb_test()
+async def free_range_ignores_ceiling(dut):
+    """RANGE free with CEILING set below the top (free ignores it): steps in consecutive clocks
+    across CEILING, and at 0 and the top: COUNT and EVENTS as the model's (no wrap at CEILING)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    top = model.max
+    for ceiling in (0, 0x25, 0x8000_8021):
+        await env.setup(model, rng_mode="free", filter_len=1, count=0, ceiling=ceiling)
+        for start in near([ceiling - 1, ceiling, ceiling + 1, 0, top], 0, top):
+            await steps_from(env, model, start, BURST)
+            await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_ranges(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

@@ -1,0 +1,187 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei reset: rst while the shaft turns, in each input state, on a rejection clock, one-clock
+resets around a step, a step soon after reset, irq low through a reset.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import pytest
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from hedsmodel import QUAD, random_walk, walk
+
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import durations, pulse_rst
+from enctools.regmap import pack, regmap
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def reset_mid_motion(dut):
+    """rst while the shaft turns: every register back to reset; then counts from the new reference."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=12345, compare=7)
+    await bus.wr("PRESET_LO", 99)
+    await bus.wr("IRQ_EN", 0xFFF)
+    wf = random_walk(rng, 200, 25.0, 40.0, p_reverse=0.1, start_pos=env.pos)
+    task = env.drv.start(wf)
+    await Timer(3000, unit="ns")
+    await FallingEdge(dut.clk)
+    dut.rst.value = 1
+    await ClockCycles(dut.clk, 3)
+    await FallingEdge(dut.clk)
+    dut.rst.value = 0
+    await task
+    env.pos = wf.positions[-1]
+    await env.settle(20)
+    for name, reg in regmap().items():
+        if reg.coherent or name in ("TIMEBASE", "STATUS", "EVENTS", "GLITCH_COUNT", "QERR_COUNT"):
+            continue
+        exp = sum((f.reset or 0) << f.lsb for f in reg.fields.values() if f.kind != "in" or
+                  f.reset is not None) if name not in ("CAPS",) else None
+        if exp is None:
+            continue
+        got = await bus.rd(name)
+        mask = 0
+        for f in reg.fields.values():
+            from enctools.regmap import size_mask
+            mask |= (size_mask(f.sized_by, env.count_w, int(dut.TS_W.value)) << f.lsb) & f.mask \
+                if f.reset is not None else 0
+        assert got & mask == exp & mask, f"{name} after rst: {got:#x}, reset {exp & mask:#x}"
+    # counting resumes from the reference taken after rst
+    model2 = QeiModel(env.count_w)
+    model2.reference(QUAD[env.pos % 4])
+    c0 = await bus.count()
+    wf = random_walk(rng, 100, 25.0, 40.0, p_reverse=0.2, start_pos=env.pos)
+    await env.play(wf, model2)
+    assert await bus.count() == (c0 + model2.count) & model2.max
+
+
+@cocotb_test()
+async def reset_in_each_state(dut):
+    """rst with the shaft standing in each of the four states (inputs held through the reset):
+    the peripheral takes that state as its reference: count 0, no QERR, no GLITCH; then it counts
+    exactly from there. (Written as the reproducer of a bug make mutate led to: `valid` rose one
+    clock before the conditioner showed the inputs; fixed in enc_conditioner_rt, d197bf9.)"""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for pos in (2, 1, 3, 0, 2):
+        a, b = QUAD[pos % 4]
+        dut.a_in.value, dut.b_in.value = a, b
+        await ClockCycles(dut.clk, 40)
+        await pulse_rst(dut, 2)
+        env.pos = pos
+        await env.settle(40)
+        assert await bus.count() == 0, f"state {a}{b} through rst: count moved"
+        ev = await bus.events()
+        assert not ev & {"QERR", "GLITCH"}, f"state {a}{b} through rst: {ev}"
+        model = QeiModel(env.count_w)
+        model.reference(QUAD[env.pos % 4])
+        wf = walk([1, 1, -1, 1, 1, 1], durations(rng, 6, 3), start_pos=env.pos)
+        await env.play(wf, model)
+        assert await bus.count() == model.count, f"state {a}{b}: count after rst"
+
+
+@cocotb_test()
+async def reset_on_rejection_clock(dut):
+    """A one-clock rst at every clock around the rejection of a lone 2-clock pulse (FILTER_LEN 3,
+    the reset value): the reset clears the pending rejection, no GLITCH afterwards."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for k in range(0, 9):
+        await FallingEdge(dut.clk)
+        dut.a_in.value = 1 - QUAD[env.pos % 4][0]
+        await ClockCycles(dut.clk, 2)
+        await FallingEdge(dut.clk)
+        dut.a_in.value = QUAD[env.pos % 4][0]
+        await ClockCycles(dut.clk, k)
+        await pulse_rst(dut, 1)
+        await env.settle(30)
+        ev = await bus.events()
+        assert "GLITCH" not in ev, f"GLITCH after a reset {k} clocks after the pulse"
+        assert await bus.rd("GLITCH_COUNT") == 0
+
+
+@cocotb_test()
+async def step_soon_after_reset(dut):
+    """A step whose conditioned level arrives a few clocks after `valid` rose (FILTER_LEN 3, the
+    reset value: the input changes between the 2nd and 3rd rising edge after rst falls) is
+    counted: the decoders leave reset as soon as the filter has settled, not later."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for direction in (1, -1, 1):
+        base = env.pos - env.pos % 4
+        dut.a_in.value, dut.b_in.value = QUAD[base % 4]
+        await ClockCycles(dut.clk, 10)
+        await pulse_rst(dut, 2)
+        await RisingEdge(dut.clk)
+        await RisingEdge(dut.clk)
+        await FallingEdge(dut.clk)
+        env.pos = base + direction
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+        await env.settle(30)
+        got = await bus.count()
+        assert got == direction & ((1 << env.count_w) - 1), \
+            f"step {direction:+d} 1.5 clocks after rst: COUNT {got:#x}"
+        assert not (await bus.events()) & {"QERR", "GLITCH"}
+
+
+@cocotb_test()
+async def one_clock_reset_in_motion(dut):
+    """A reset of one clock in each clock around an applied down step (and up step): afterwards
+    SNAP_DELTA (a snapshot by command, the shaft still) is 0 and COUNT is 0 -- nothing of the
+    step before the reset leaks into the accumulators after it."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for direction in (-1, 1):
+        for offset in range(0, 9):
+            model = QeiModel(env.count_w)
+            await env.setup(model, count=50, filter_len=1)
+            await FallingEdge(dut.clk)
+            env.pos += direction
+            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+            await ClockCycles(dut.clk, offset)
+            await FallingEdge(dut.clk)
+            dut.rst.value = 1
+            await FallingEdge(dut.clk)
+            dut.rst.value = 0
+            await env.settle(30)
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+            await env.settle(4)
+            delta = await bus.rd("SNAP_DELTA")
+            assert delta == 0, f"step {direction}, reset {offset} clocks after: SNAP_DELTA {delta:#x}"
+            assert await bus.count() == 0, f"step {direction}, reset {offset} clocks after: COUNT not 0"
+
+
+@cocotb_test()
+async def irq_low_in_reset(dut):
+    """irq is 0 in every clock of a reset and after it, even with events pending and enabled
+    when rst comes."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await bus.wr("IRQ_EN", 0xFFF)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))  # SNAP_READY pending
+    await env.settle(20)
+    assert dut.irq.value == 1
+    await FallingEdge(dut.clk)
+    dut.rst.value = 1
+    for k in range(4):
+        await RisingEdge(dut.clk)
+        await FallingEdge(dut.clk)
+        assert dut.irq.value == 0, f"irq high in clock {k} of the reset"
+    dut.rst.value = 0
+    for k in range(6):
+        await FallingEdge(dut.clk)
+        assert dut.irq.value == 0, f"irq high {k} clocks after the reset"
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_reset(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

@@ -1,0 +1,305 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei snapshots: SNAP_COUNT, SNAP_TIME, SNAP_EDGE_TIME, SNAP_DELTA and SNAP_EDGE_DELTA by
+bus command, snap_in and the unit timer (SNAP_PERIOD): coherence within one clock, deltas across
+wraps and reversals, held values, wide values.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import cocotb
+import pytest
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from hedsmodel import QUAD, random_walk, walk
+
+from enctools.qei.bus import PERIOD_PS, T_NS, signed
+from enctools.qei.env import CONFIG_IDS, CONFIGS, ClockTrace, begin, read_snapshot, run_feature
+from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import durations
+from enctools.regmap import event_bits, pack
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def snapshot_coherence(dut):
+    """Snapshots by bus command, snap_in and the unit timer while the shaft turns: SNAP_COUNT,
+    SNAP_TIME, SNAP_EDGE_TIME and SNAP_DELTA all belong to one clock."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=1000, filter_len=1)
+    trace = ClockTrace(dut)
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    snaps = []
+    switched = {}  # edge type -> trace clock of the switch to it
+    for edge in ("any", "a_rising"):
+        switched[edge] = len(trace.tb)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        await bus.wr("SNAP_PERIOD", rng.randint(60, 90))
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        wf = random_walk(rng, 300, 2.2 * T_NS, 6 * T_NS, p_reverse=0.15, start_pos=env.pos)
+        task = cocotb.start_soon(env.drv.play(wf))
+        while not task.done():
+            how = rng.choice(["cmd", "in", "wait"])
+            if how == "cmd":
+                await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, IN_EN=1, PERIOD_EN=1, EDGE=edge))
+            elif how == "in":
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 1
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 0
+            else:
+                await ClockCycles(dut.clk, rng.randint(5, 40))
+            # the unit timer keeps snapping; read whatever is latched now, coherently or not
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=0, PERIOD_EN=0, EDGE=edge))
+            snaps.append((edge, await read_snapshot(bus)))
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1, PERIOD_EN=1, EDGE=edge))
+        await task
+        env.pos = wf.positions[-1]
+    await env.settle()
+    assert len(snaps) >= 20
+    prev_i = None
+    for edge, s in snaps:
+        i = trace.clock_of(s["time"], after=0 if prev_i is None else max(prev_i - 5, 0))
+        count = (s["count_hi"] << 32 | s["count"]) & model.max
+        assert count == trace.count[i], f"SNAP_COUNT {count} is not the count of clock {i}"
+        exp_edge = trace.last_edge_time(i, edge == "a_rising")
+        edges = trace.arise if edge == "a_rising" else trace.any
+        if not any(edges[switched[edge] + 2:i]):
+            exp_edge = None  # no edge of the new type since EDGE changed: not defined yet
+        if exp_edge is not None:
+            assert s["edge_time"] == exp_edge & ts_mask, \
+                f"SNAP_EDGE_TIME {s['edge_time']}, last {edge} edge at {exp_edge} (clock {i})"
+        prev_i = i
+    # deltas: consecutive snapshots (no other snapshot in between) differ by SNAP_DELTA
+    checked = 0
+    for (_, a), (_, b) in zip(snaps, snaps[1:]):
+        ia, ib = trace.clock_of(a["time"]), trace.clock_of(b["time"])
+        if ib > ia and not any(trace.tb[k] == 0 for k in range(ia, ib)):
+            steps = trace.count[ib] - trace.count[ia]
+            if signed(b["delta"]) == steps:
+                checked += 1
+    assert checked >= 1, "no snapshot pair showed SNAP_DELTA = the count change between them"
+    trace.task.cancel()
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def snapshot_deltas_across_wraps(dut):
+    """SNAP_DELTA counts applied steps across modulo wraps and limits; SNAP_EDGE_DELTA is the
+    count change between the last selected edges (any edge, and A rising with x4 counting)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for mode, edge in (("modulo", "any"), ("modulo", "a_rising"), ("limit", "any"), ("free", "a_rising")):
+        ceiling = 9 if mode != "free" else None
+        await env.setup(model, rng_mode=mode, count=3, ceiling=ceiling)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        await env.settle()
+        model.delta = 0
+        pos_hist = [env.pos]  # 4X positions, for the A-rising edge deltas
+        prev_edge_pos = None
+        for seg in range(6):
+            steps = [rng.choice([1, 1, 1, -1])] * rng.randint(5, 40)
+            wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
+            await env.play(wf, model)
+            pos_hist += wf.positions[1:]
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+            await env.settle(4)
+            snap = await read_snapshot(bus)
+            assert signed(snap["delta"]) == model.delta, \
+                f"{mode}: SNAP_DELTA {signed(snap['delta'])}, model {model.delta} applied steps"
+            # edge delta: position change between the last selected edges, in free/modulo
+            # every step is applied, so counts = positions
+            if mode != "limit":
+                if edge == "any":
+                    last = len(pos_hist) - 1
+                else:
+                    rises = [k for k in range(1, len(pos_hist))
+                             if QUAD[pos_hist[k - 1] % 4][0] == 0 and QUAD[pos_hist[k] % 4][0] == 1]
+                    last = rises[-1] if rises else None
+                if last is not None and prev_edge_pos is not None:
+                    exp = pos_hist[last] - prev_edge_pos
+                    assert signed(snap["edge_delta"]) == exp, \
+                        f"{mode}/{edge}: SNAP_EDGE_DELTA {signed(snap['edge_delta'])}, expected {exp}"
+                if last is not None:
+                    prev_edge_pos = pos_hist[last]
+            model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def unit_timer_period(dut):
+    """SNAP_PERIOD = P: the unit timer snaps every P ticks (0 and 1: every tick), at PRESCALE 0
+    and 1: SNAP_TIME values read 2.5 periods apart differ by a multiple of P, and SNAP_TIME is never
+    more than a period behind TIMEBASE. P values set each of the low 13 bits somewhere."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    for pre, p in ((0, 0), (0, 1), (0, 2), (0, 3), (0, 0x5A), (0, 0x1A5), (1, 0xC3),
+                   (0, 0x2C3), (0, 0x200), (0, 0x6F0), (0, 0x80F), (0, 0x1003)):
+        step = max(p, 1)
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("SNAP_PERIOD", p)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        times = []
+        for wait in (step + 5, 2 * step + step // 2 + 7):
+            await Timer(wait * (pre + 1) * PERIOD_PS, unit="ps")
+            t = await bus.rd("SNAP_TIME")
+            tb = await bus.rd("TIMEBASE")
+            assert (tb - t) & ts_mask <= step + 40, \
+                f"SNAP_PERIOD {p} PRESCALE {pre}: SNAP_TIME {t} a period behind TIMEBASE {tb}"
+            times.append(t)
+        d = (times[1] - times[0]) & ts_mask
+        assert d % step == 0 and d >= 2 * step, \
+            f"SNAP_PERIOD {p} PRESCALE {pre}: snapshots {d} ticks apart, not a multiple of {step}"
+        await bus.wr("SNAP_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+
+
+@cocotb_test()
+async def snapshot_wide_values(dut):
+    """SNAP_COUNT of counts with every bit pattern (the high half too): a snapshot holds them;
+    SNAP_TIME and SNAP_EDGE_TIME of an edge taken 4,200 to 12,600 clocks after reset (timebase
+    bits 12 and 13) lie between the TIMEBASE read before the edge and the one after the snapshot."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    for k, value in enumerate((0x5555_5555_5555_5555, 0xAAAA_AAAA_AAAA_AAAA,
+                               0xFFFF_FFFF_FFFF_FFFF, 0x0123_4567_89AB_CDEF)):
+        value &= model.max
+        await env.setup(model, count=value, en=0)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+        await env.settle(4)
+        for gap in (1, 2, 0):  # held while nothing else snaps (reads an odd and an even clock apart)
+            got = await bus.rd("SNAP_COUNT_LO") | await bus.rd("SNAP_COUNT_HI") << 32
+            assert got == value, f"SNAP_COUNT {got:#x}, count {value:#x}"
+            if gap:
+                await ClockCycles(dut.clk, gap)
+        if k:
+            await Timer(4200 * PERIOD_PS, unit="ps")
+        before = await bus.rd("TIMEBASE")
+        await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        t_snap, t_edge = await bus.rd("SNAP_TIME"), await bus.rd("SNAP_EDGE_TIME")
+        after = await bus.rd("TIMEBASE")
+        span = (after - before) & ts_mask
+        assert (t_edge - before) & ts_mask <= (t_snap - before) & ts_mask <= span, \
+            f"TIMEBASE {before:#x}, SNAP_EDGE_TIME {t_edge:#x}, SNAP_TIME {t_snap:#x}, TIMEBASE {after:#x}"
+
+
+@cocotb_test()
+async def unit_timer_prescaled(dut):
+    """The unit timer at PRESCALE 2 .. 5 (ticks 3 .. 6 clocks apart: clocks without a tick between
+    the ticks): SNAP_PERIOD = P gives a SNAP_READY exactly P x (PRESCALE + 1) clocks after the
+    previous one, and SNAP_TIME values exactly P ticks apart."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    await bus.wr("IRQ_EN", event_bits("SNAP_READY"))
+    for pre, p in ((2, 0x2D), (3, 0x24), (3, 0x28), (4, 0x1E), (5, 0x1C), (3, 0x2C), (5, 0x25)):
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("SNAP_PERIOD", p)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        seen = []
+        for k in range(4):
+            await bus.events()  # clear SNAP_READY; the next one raises irq
+            n = 0
+            while dut.irq.value == 0:
+                await RisingEdge(dut.clk)
+                n += 1
+                assert n < 4 * p * (pre + 1) + 100, f"PRESCALE {pre} SNAP_PERIOD {p}: no snapshot"
+            at = round(get_sim_time("ns") / T_NS)
+            t = await bus.rd("SNAP_TIME")
+            seen.append((at, t))
+        for (c0, t0), (c1, t1) in zip(seen[1:], seen[2:]):  # (the first one: timer phase unknown)
+            assert c1 - c0 == p * (pre + 1), \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: snapshots {c1 - c0} clocks apart, not {p * (pre + 1)}"
+            assert (t1 - t0) & ts_mask == p, \
+                f"PRESCALE {pre} SNAP_PERIOD {p}: SNAP_TIME {t0:#x} then {t1:#x}, not {p} ticks apart"
+        await bus.wr("SNAP_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb_test()
+async def snapshot_deltas_held(dut):
+    """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
+    an odd and an even number of clocks apart, after walks forward, back and turning between two
+    snapshots (positive and negative deltas, EDGE any and A rising): always the applied steps since
+    the previous snapshot, and the count change between the last selected edges of the two."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for edge in ("any", "a_rising"):
+        await env.setup(model, count=1000, filter_len=1)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+        await env.settle(4)
+        last_edge = None  # 4X position of the last selected edge up to the previous snapshot
+        # each a walk between two snapshots; the mixed ones turn within it (an accumulator that
+        # counts down from a positive value, up from a negative one)
+        for steps in ([1] * 9, [-1] * 14, [1] * 5, [-1] * 3, [1] * 22, [-1] * 30,
+                      [1] * 7 + [-1] * 3, [-1] * 6 + [1] * 2, [1] * 3 + [-1] * 8):
+            n = sum(steps)
+            wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+            await env.play(wf, model)
+            rises = [p for q, p in zip(wf.positions, wf.positions[1:])
+                     if edge == "any" or (QUAD[q % 4][0], QUAD[p % 4][0]) == (0, 1)]
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE=edge))
+            await env.settle(4)
+            for gap in (1, 2, 0):
+                delta = await bus.rd("SNAP_DELTA")
+                edge_delta = await bus.rd("SNAP_EDGE_DELTA")
+                assert delta == n & 0xFFFFFFFF, f"EDGE {edge}: SNAP_DELTA {delta:#x} after {n} steps"
+                if rises and last_edge is not None:
+                    exp = (rises[-1] - last_edge) & 0xFFFFFFFF
+                    assert edge_delta == exp, \
+                        f"EDGE {edge}: SNAP_EDGE_DELTA {edge_delta:#x}, expected {exp:#x} after {n} steps"
+                if gap:
+                    await ClockCycles(dut.clk, gap)
+            if rises:
+                last_edge = rises[-1]
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def snapshot_edge_delta_after_reversal(dut):
+    """SNAP_CTRL.EDGE = A rising: a snapshot taken after steps back behind the last rising edge of
+    A (steps counted since that edge go down from a positive value), then walks forward through
+    more rising edges: each SNAP_EDGE_DELTA is the count change between the last rising edges of
+    A before the two snapshots."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    await env.setup(model, count=5000, filter_len=1)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="a_rising"))
+    await env.settle(4)
+    last_edge = None
+    for steps in ([1] * 6 + [-1], [1] * 9 + [-1] * 2, [1] * 7 + [-1], [1] * 10 + [-1] * 3,
+                  [1] * 13 + [-1], [1] * 5 + [-1] * 2):
+        wf = walk(steps, [3 * T_NS] * len(steps), start_pos=env.pos)
+        await env.play(wf, model)
+        rises = [p for q, p in zip(wf.positions, wf.positions[1:])
+                 if (QUAD[q % 4][0], QUAD[p % 4][0]) == (0, 1)]
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="a_rising"))
+        await env.settle(4)
+        edge_delta = await bus.rd("SNAP_EDGE_DELTA")
+        if rises and last_edge is not None:
+            exp = (rises[-1] - last_edge) & 0xFFFFFFFF
+            assert edge_delta == exp, f"after {steps}: SNAP_EDGE_DELTA {edge_delta:#x}, expected {exp:#x}"
+        if rises:
+            last_edge = rises[-1]
+    await bus.wr("SNAP_CTRL", 0)
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_snapshots(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

@@ -1,0 +1,317 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei timebase and timing unit: TIMEBASE and TB_PRESCALE, PERIOD capture (N edges,
+direction change, overflow, held values), STALL_TIMEOUT and STATUS.STALLED.
+
+Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
+cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
+Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import cocotb
+import pytest
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from hedsmodel import QUAD, walk
+
+from enctools.qei.bus import PERIOD_PS, T_NS
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import durations, play_clocks, step_clocks
+from enctools.regmap import event_bits, pack, regmap
+from enctools.tb import cocotb_test
+
+
+@cocotb_test()
+async def prescaler_and_snap_in(dut):
+    """TIMEBASE advances once every PRESCALE + 1 clocks: snap_in rising edges G clocks apart give
+    SNAP_TIME values G / (PRESCALE + 1) apart (floor or ceiling); snap_in held high snaps once."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_w = int(dut.TS_W.value)
+    ts_mask = (1 << ts_w) - 1
+    cyc = 0
+
+    async def count_clocks():
+        nonlocal cyc
+        while True:
+            await RisingEdge(dut.clk)
+            cyc += 1
+
+    counter = cocotb.start_soon(count_clocks())
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1))
+
+    async def snap(hold):
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 1
+        at = cyc
+        await ClockCycles(dut.clk, hold)
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 0
+        await env.settle(2)
+        return at, await bus.rd("SNAP_TIME")
+
+    for pre in (0, 1, 2, 9, 255):
+        await bus.wr("TB_PRESCALE", pre)
+        await env.settle(5)
+        c0, t0 = await snap(rng.randint(1, 4))
+        await ClockCycles(dut.clk, rng.randint(100, 700))
+        await bus.events()
+        c1, t1 = await snap(rng.randint(1, 4))
+        assert "SNAP_READY" in await bus.events()
+        gap = c1 - c0
+        diff = (t1 - t0) & ts_mask
+        lo, hi = gap // (pre + 1), -(-gap // (pre + 1))
+        assert lo <= diff <= hi, f"PRESCALE {pre}: {gap} clocks gave {diff} ticks, not {lo}..{hi}"
+        # the timebase itself: two reads G clocks apart
+        tb0 = await bus.rd("TIMEBASE")
+        assert 0 <= (tb0 - t1) & ts_mask <= 80 // (pre + 1) + 1
+    counter.cancel()
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def period_capture(dut):
+    """PERIOD over N edges at constant speed, the direction-change flag, PERIOD_READY, and the
+    overflow flag and PERIOD_OVF event (TS_W = 16 builds only: 65,536 ticks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    lsb = regmap()["PERIOD_CTRL"].fields
+    for edge, n, d in (("any", 4, 7), ("any", 1, 12), ("a_rising", 2, 5)):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE=edge, N=n))
+        # states of exactly d clocks: every edge interval is d clocks
+        steps = [1] * 40
+        wf = walk(steps, [d * T_NS] * 40, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        period = await bus.rd("PERIOD")
+        per_edge = d * (4 if edge == "a_rising" else 1)
+        assert period == n * per_edge, f"{edge} N={n} states {d}: PERIOD {period}, expected {n * per_edge}"
+        assert not ctrl >> lsb["OVERFLOW"].lsb & 1 and not ctrl >> lsb["DIR_CHANGE"].lsb & 1
+        assert "PERIOD_READY" in await bus.events()
+        # a clean measurement after a reversal: DIR_CHANGE clear again
+        wf = walk([1, 1, -1, -1, -1] + [-1] * 12 + [1] * 20, [d * T_NS] * 37, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        assert not ctrl >> lsb["DIR_CHANGE"].lsb & 1, "DIR_CHANGE stuck after a clean measurement"
+    # direction change caught: N = 8 any edges around a reversal, read right after that capture
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=8))
+    wf = walk([1] * 3, [6 * T_NS] * 3, start_pos=env.pos)
+    await env.play(wf, None)  # first edges: start the measurement
+    wf = walk([1, 1, -1, -1, -1, -1, -1, -1], [6 * T_NS] * 8, start_pos=env.pos)
+    await bus.events()
+    await env.play(wf, None)
+    ctrl = await bus.rd("PERIOD_CTRL")
+    assert ctrl >> lsb["DIR_CHANGE"].lsb & 1, "a reversal inside the measurement did not set DIR_CHANGE"
+    if int(dut.TS_W.value) == 16:
+        await bus.events()
+        await env.settle(65540)
+        assert "PERIOD_OVF" in await bus.events()
+        wf = walk([1] * 9, [6 * T_NS] * 9, start_pos=env.pos)
+        await env.play(wf, None)
+        ctrl = await bus.rd("PERIOD_CTRL")
+        assert ctrl >> lsb["OVERFLOW"].lsb & 1, "OVERFLOW flag not set"
+        assert await bus.rd("PERIOD") == 0xFFFF
+    else:
+        dut._log.info("TS_W = %d: period overflow is checked in the TS_W = 16 build", int(dut.TS_W.value))
+    await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb_test()
+async def stall_and_recovery(dut):
+    """STALL_TIMEOUT: the stall event and STATUS.STALLED after that many ticks without a count
+    edge, not before; cleared by the next edge; once per stop."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0)
+    stalled_lsb = regmap()["STATUS"].fields["STALLED"].lsb
+    await bus.wr("TB_PRESCALE", 1)  # a tick every 2 clocks
+    await bus.wr("STALL_TIMEOUT", 150)  # 300 clocks
+    for rep in range(2):
+        wf = walk([1] * 10, durations(rng, 10), start_pos=env.pos)
+        await env.play(wf, None)
+        await bus.events()
+        await ClockCycles(dut.clk, 180)
+        assert "STALL" not in await bus.events(), "stall before the timeout"
+        assert not (await bus.rd("STATUS")) >> stalled_lsb & 1
+        await ClockCycles(dut.clk, 200)
+        assert "STALL" in await bus.events(), "no stall after the timeout"
+        assert (await bus.rd("STATUS")) >> stalled_lsb & 1
+        await ClockCycles(dut.clk, 400)
+        assert "STALL" not in await bus.events(), "the stall event repeated during one stop"
+        await env.play(walk([-1], [30.0], start_pos=env.pos), None)
+        assert not (await bus.rd("STATUS")) >> stalled_lsb & 1, "STALLED not cleared by an edge"
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("TB_PRESCALE", 0)
+
+
+@cocotb_test()
+async def period_large_n(dut):
+    """PERIOD_CTRL.N up to 255: PERIOD = N x the edge interval (any edge, states of 3 clocks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    for n in (17, 100, 255, 0xAA):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=n))
+        steps = 2 * n + 8
+        await env.play(walk([1] * steps, [3 * T_NS] * steps, start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        assert period == 3 * n, f"N={n}: PERIOD {period}, expected {3 * n}"
+        await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb_test()
+async def stall_timeout_exact(dut):
+    """The stall comes exactly STALL_TIMEOUT ticks after the last step: the clocks from a step to
+    irq (IRQ_EN = STALL) differ between two timeouts by exactly their difference (PRESCALE 0), or
+    by it x (PRESCALE + 1) within the prescaler's phase."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    await bus.wr("IRQ_EN", event_bits("STALL"))
+    clocks = {}
+    for pre, t in ((0, 0x40), (0, 0x2F), (0, 0x1F0), (0, 0x2A5), (0, 0x35A), (0, 0x0CB), (0, 0x104),
+                   (0, 0x20), (0, 0x200), (0, 0x1005), (0, 4), (0, 3), (0, 2), (0, 1), (2, 0x40), (2, 0x13),
+                   (2, 0x6D)):
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("STALL_TIMEOUT", t)
+        await Timer((t * (pre + 1) + 40) * PERIOD_PS, unit="ps")  # any stall of the wait is over
+        await RisingEdge(dut.clk)
+        await bus.events()
+        await env.settle(3)
+        assert dut.irq.value == 0
+        await FallingEdge(dut.clk)
+        env.pos += 1
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+        n = 0
+        while dut.irq.value == 0:
+            await RisingEdge(dut.clk)
+            n += 1
+            assert n < t * (pre + 1) + 200, f"STALL_TIMEOUT {t} PRESCALE {pre}: no stall"
+        clocks[(pre, t)] = n
+        await bus.events()
+    for (pre, t), n in clocks.items():
+        n0 = clocks[(pre, 0x40)]
+        d = n - n0 - (t - 0x40) * (pre + 1)
+        assert abs(d) <= pre, f"STALL_TIMEOUT {t} PRESCALE {pre}: {n} clocks to the stall, {n0} at 0x40"
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb_test()
+async def prescaler_long(dut):
+    """TIMEBASE at PRESCALE values that set bits 0 .. 8, over 8 to 150 ticks (2,400 clocks or
+    more): snap_in rising edges G clocks apart give SNAP_TIME values G / (PRESCALE + 1) apart
+    (floor or ceiling)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", IN_EN=1))
+
+    async def snap():
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 1
+        at = round(get_sim_time("ns") / T_NS)
+        await ClockCycles(dut.clk, 2)
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 0
+        await env.settle(3)
+        return at, await bus.rd("SNAP_TIME")
+
+    for k, pre in enumerate((0x25, 0x2A, 0x3F, 0x30, 0x71, 0x1F0, 0x0F)):
+        await bus.wr("TB_PRESCALE", pre)
+        await env.settle(5)
+        c0, t0 = await snap()
+        ticks = max(8, 2400 // (pre + 1))
+        await Timer((ticks * (pre + 1) + 7 * k) * PERIOD_PS, unit="ps")
+        c1, t1 = await snap()
+        gap, diff = c1 - c0, (t1 - t0) & ts_mask
+        lo, hi = gap // (pre + 1), -(-gap // (pre + 1))
+        assert lo <= diff <= hi, f"PRESCALE {pre}: {gap} clocks gave {diff} ticks, not {lo}..{hi}"
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def period_above_2k_ticks(dut):
+    """PERIOD of edge intervals of 2,652 ticks (bits 2 .. 11 in the tick counter and PERIOD; the
+    other tests measure 765 ticks at most, or the 2^16 overflow at TS_W 16): exact, and held
+    (read an odd and an even number of clocks apart); and of 314 ticks at PRESCALE 1 and 3 (the
+    tick counter holds between ticks): within one tick."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    for pre in (1, 3):  # ticks PRESCALE + 1 clocks apart: clocks without a tick in between
+        await bus.wr("TB_PRESCALE", pre)
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+        clocks = 0x13A * (pre + 1) + 1
+        await env.play(walk([1, 1, 1], [clocks * T_NS] * 3, start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        assert abs(period - 0x13A) <= 1, f"PRESCALE {pre}: PERIOD {period:#x}, expected 0x13a (+-1)"
+        await bus.wr("PERIOD_CTRL", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    d = 0x0A5C
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    for gap in (1, 2, 0):  # held: the same value at reads an odd and an even clock apart
+        period = await bus.rd("PERIOD")
+        assert period == d, f"PERIOD {period:#x}, expected {d:#x}"
+        if gap:
+            await ClockCycles(dut.clk, gap)
+    await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb_test()
+async def period_consecutive_edges(dut):
+    """PERIOD_CTRL.N 2 .. 17 with an edge in every clock (FILTER_LEN 1, one state per clock: the
+    edge after a measurement's start edge, and the one after the next-to-last, come in the very
+    next clock): PERIOD = N ticks, N edges of one clock each."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    for n in (2, 3, 5, 10, 12, 15, 17):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=n))
+        await play_clocks(env, None, step_clocks(env.pos, [1] * (3 * n + 6)))
+        await env.settle()
+        period = await bus.rd("PERIOD")
+        assert period == n, f"N={n}, an edge every clock: PERIOD {period}, expected {n}"
+        await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb_test()
+async def period_held_after_disable(dut):
+    """PERIOD keeps the last measurement after PERIOD_CTRL.EN is cleared: a period of 0x2A5C ticks
+    (bit 13 set, within TS_W 16), read an odd and an even number of clocks apart, before and after
+    the clear."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    d = 0x2A5C
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    for enabled in (True, False):
+        if not enabled:
+            await bus.wr("PERIOD_CTRL", 0)
+        for gap in (1, 2, 3, 0):
+            period = await bus.rd("PERIOD")
+            assert period == d, f"EN {int(enabled)}: PERIOD {period:#x}, expected {d:#x}"
+            if gap:
+                await ClockCycles(dut.clk, gap)
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_timing(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)

@@ -1,0 +1,160 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The enc_qei test environment shared by the feature files of tb/enc_qei/.
+
+- ``CONFIGS`` / ``CONFIG_IDS``: the builds every feature file runs on (enc_qei_wb at COUNT_W 32 /
+  TS_W 32, enc_qei_axil at COUNT_W 64 / TS_W 16), and ``run_feature()``, the pytest side of a
+  feature file: one build name per configuration, so that every feature file shares its build.
+- ``Env`` (``begin(dut)`` makes one): the bus, the quadrature driver and the stimulus position;
+  ``setup`` programs the peripheral and the model alike, ``play`` drives a waveform into both,
+  ``check`` compares COUNT and EVENTS with the model.
+- ``ClockTrace`` and ``read_snapshot``: what the design did in each clock, and the snapshot
+  registers, for the snapshot tests.
+
+Stimulus helpers (waveforms, clock-exact steps, resets) are in enctools.qei.stimulus.
+"""
+
+from __future__ import annotations
+
+import cocotb
+from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+from cocotbext.quadrature import QuadratureDriver
+from hedsmodel import QUAD
+
+from enctools.qei.bus import PERIOD_PS, QeiBus
+from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import FILTER
+from enctools.regmap import pack
+from enctools.tb import start
+
+# ---- configurations and the pytest side -----------------------------------------------------------
+CONFIGS = (("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16))  # (top, COUNT_W, TS_W)
+CONFIG_IDS = tuple(f"{top}-c{count_w}-t{ts_w}" for top, count_w, ts_w in CONFIGS)
+
+
+def build_name(top: str, count_w: int, ts_w: int) -> str:
+    """The one build name of a configuration: every feature file runs on the same build."""
+    return f"{top}_c{count_w}_t{ts_w}"
+
+
+def run_feature(module: str, top: str, count_w: int, ts_w: int):
+    """Run the cocotb tests of feature file ``module`` (its ``__name__``) on one configuration."""
+    from enctools.harness import run  # (here: the simulator's Python, importing env, needs no harness)
+
+    return run(top, module, name=build_name(top, count_w, ts_w),
+               parameters={"COUNT_W": count_w, "TS_W": ts_w})
+
+
+# ---- the environment -------------------------------------------------------------------------------
+class Env:
+    def __init__(self, dut, rng):
+        self.dut, self.rng = dut, rng
+        self.bus = QeiBus(dut, rng)
+        self.count_w = int(dut.COUNT_W.value)
+        self.drv = QuadratureDriver(dut.a_in, dut.b_in, dut.z_in, clock_period_ps=PERIOD_PS)
+        self.pos = 0  # 4X position of the stimulus now
+
+    async def settle(self, clocks: int = 12):
+        await ClockCycles(self.dut.clk, clocks)
+
+    async def setup(self, model: QeiModel, func="x4", rng_mode="free", filter_len=FILTER,
+                    count=0, ceiling=None, compare=None, en=1):
+        bus = self.bus
+        model.range = rng_mode
+        model.ceiling = model.max if ceiling is None else ceiling
+        model.compare = 0 if compare is None else compare
+        model.en = bool(en)
+        await bus.set64("CEILING", model.ceiling)
+        await bus.set64("COMPARE", model.compare)
+        ctrl = pack("CTRL", EN=en, FUNC=func, RANGE=rng_mode, FILTER_LEN=filter_len)
+        await bus.wr("CTRL", ctrl)
+        model.set_func(func, QUAD[self.pos % 4])
+        await bus.set_count(count)
+        model.write_count(count)
+        await self.settle()
+        await bus.events()
+        await bus.wr("QERR_COUNT", 0)
+        await bus.wr("GLITCH_COUNT", 0)
+        model.take_events()
+        model.qerrs = 0
+
+    async def play(self, wf, model: QeiModel | None, zfun=None):
+        """Play wf from the present position; feed every event to the model."""
+        index = None
+        if zfun is not None:
+            index = [(t, zfun(p)) for (t, _, _), p in zip(wf.events, wf.positions)]
+        await self.drv.play(wf, index=index)
+        if model is not None:
+            # every event, the first included: it holds the present A/B (no step) but sets Z to
+            # zfun of the start position, which the driver plays too (an index edge there)
+            for (_, a, b), p in zip(wf.events, wf.positions):
+                model.sample((a, b), zfun(p) if zfun else 0)
+        self.pos = wf.positions[-1]
+        await self.settle()
+
+    async def check(self, model: QeiModel, what: str, events=True):
+        got = await self.bus.count()
+        assert got == model.count, f"{what}: COUNT {got:#x}, model {model.count:#x}"
+        if events:
+            ev = await self.bus.events()
+            exp = model.take_events()
+            assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
+
+
+async def begin(dut):
+    rng = await start(dut, PERIOD_PS, inputs={"a_in": 0, "b_in": 0, "z_in": 0, "probe_in": 0,
+                                               "snap_in": 0})
+    env = Env(dut, rng)
+    await env.settle(30)
+    return env, rng
+
+
+def channel(dut, k: int = 0):
+    """Channel k's enc_qei_channel instance inside the bus adapter (its core is ``.u_core``, its
+    timing unit ``.g_timing.u_timing``)."""
+    return dut.u_qei.g_ch[k].u_chan
+
+
+# ---- clock trace and snapshots ---------------------------------------------------------------------
+class ClockTrace:
+    """Per clock (sampled after each rising edge): the count, the timebase and the decoder's edge
+    pulses of the core, read from the design's registers. It says what happened in each clock, so
+    a snapshot's values can be checked to come from one and the same clock."""
+
+    def __init__(self, dut):
+        chan = channel(dut)
+        core, timing = chan.u_core, chan.g_timing.u_timing
+        self.sig = (core.count_q, timing.timebase, core.edge_any, core.edge_a_rise)
+        self.count, self.tb, self.any, self.arise = [], [], [], []
+        self.task = cocotb.start_soon(self._run(dut))
+
+    async def _run(self, dut):
+        while True:
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            c, t, e, r = (int(x.value) for x in self.sig)
+            self.count.append(c)
+            self.tb.append(t)
+            self.any.append(e)
+            self.arise.append(r)
+
+    def clock_of(self, tb_value: int, after: int = 0) -> int:
+        """The clock index whose timebase is tb_value (prescaler 0: one clock per value)."""
+        for i in range(after, len(self.tb)):
+            if self.tb[i] == tb_value:
+                return i
+        raise AssertionError(f"no clock with timebase {tb_value}")
+
+    def last_edge_time(self, i: int, a_rising: bool) -> int | None:
+        """Timestamp of the last edge a snapshot in clock i includes: an edge of clock j <= i - 1,
+        stamped with the timebase of clock j + 1 (the timing unit sees the core a clock late)."""
+        edges = self.arise if a_rising else self.any
+        for j in range(i - 1, -1, -1):
+            if edges[j]:
+                return self.tb[j + 1]
+        return None
+
+
+async def read_snapshot(bus):
+    return {n: await bus.rd(r) for n, r in (
+        ("count", "SNAP_COUNT_LO"), ("count_hi", "SNAP_COUNT_HI"), ("time", "SNAP_TIME"),
+        ("edge_time", "SNAP_EDGE_TIME"), ("delta", "SNAP_DELTA"), ("edge_delta", "SNAP_EDGE_DELTA"))}
