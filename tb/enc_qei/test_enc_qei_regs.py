@@ -13,7 +13,7 @@ import sys
 import pytest
 
 from enctools.gen import cli as gen_regs
-from enctools.regmap import compile_rdl
+from enctools.regmap import compile_rdl, nodes
 from enctools.paths import TOP
 
 
@@ -59,8 +59,7 @@ def test_c_header_compiles(tmp_path):
 
 
 def test_rdl_has_the_contract_names():
-    top = compile_rdl()
-    regs = {r.inst_name: r for r in top.registers()}
+    regs = {r.inst_name: r for _, _, r in nodes()}
     for name in ("ID", "CAPS", "CTRL", "STATUS", "COUNT_LO", "COUNT_HI", "PRESET_LO", "CEILING_LO",
                  "COMPARE_LO", "INDEX_CTRL", "INDEX_LATCH_LO", "PROBE_CTRL", "PROBE_LATCH_LO",
                  "EVENTS", "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "TIMEBASE", "SNAP_CTRL",
@@ -80,3 +79,27 @@ def test_rdl_has_the_contract_names():
     events = {f.inst_name for f in regs["EVENTS"].fields()}
     assert events == {"OVERFLOW", "UNDERFLOW", "INDEX", "PROBE", "CMP", "QERR", "GLITCH",
                       "DIR_CHANGE", "STALL", "SNAP_READY", "PERIOD_READY", "PERIOD_OVF"}
+
+
+def test_rdl_has_the_multi_axis_names():
+    """The contract's multi-axis part: the channel registers a regfile array named chan, the global
+    registers beside it, CAPS.PROFILE an enum with full and lean."""
+    top = compile_rdl()
+    chan = [n for n in top.descendants() if n.inst_name == "chan"]
+    assert len(chan) == 1 and chan[0].is_array, "no regfile array named chan"
+    assert chan[0].array_dimensions == [16]
+    groups = {r.inst_name: g for g, _, r in nodes()}
+    for name in ("ID", "CAPS", "TIMEBASE", "TB_PRESCALE", "GSNAP_CTRL", "GSNAP_PERIOD",
+                 "GSNAP_TIME", "IRQ_SUMMARY"):
+        assert groups.get(name) == "glb", f"{name} is not a global register"
+    assert {f.inst_name for f in _reg("GSNAP_CTRL").fields()} >= {"CMD", "IN_EN", "PERIOD_EN"}
+    profile = _reg("CAPS").get_child_by_name("PROFILE").get_property("encode")
+    assert {m.name for m in profile} >= {"full", "lean"}
+    assert _reg("CAPS").get_child_by_name("CHANNELS") is not None
+    for name in ("COUNT_LO", "SNAP_COUNT_LO", "EVENTS", "IRQ_EN", "SNAP_CTRL"):
+        assert groups.get(name) == "chan", f"{name} is not a channel register"
+
+
+def _reg(name):
+    return next(r for _, _, r in nodes() if r.inst_name == name)
+

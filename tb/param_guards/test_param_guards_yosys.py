@@ -30,6 +30,9 @@ for _path, _module, _param, _value, _ok in guard_cases():
         BAD.setdefault(_module, []).append((_param, _value, _param.split("_", 1)[-1]
                                             if _param == "PHASE_WINDOW_LOG2" else _param))
 BAD["icebreaker_top"] += [("LINE_HZ", 0, "LINE_HZ"), ("BAUD", 12_000_000, "BAUD")]
+# enc_qei's relational limits (as in test_param_guards.RELATIONAL): parameters set together
+BAD_SETS = [(top, params, name) for top in ("enc_qei_wb", "enc_qei_axil") for params, name in (
+    ({"CHANNELS": 2, "ADDR_W": 8}, "ADDR_W"), ({"PROFILE": 3, "COUNT_W": 16}, "COUNT_W"))]
 
 
 def yosys() -> str:
@@ -69,3 +72,13 @@ def test_bad_parameter_stops_yosys(module, param, value, name):
     assert proc.returncode != 0, f"yosys accepted {module} with {param}={value}"
     assert re.search(rf"ERROR.*\b\w*{name}\b", out), \
         f"yosys stopped {module} {param}={value} without naming {name}:\n{out}"
+
+
+@pytest.mark.parametrize("module,params,name", BAD_SETS,
+                         ids=[f"{m}-{n}" for m, _, n in BAD_SETS])
+def test_relational_guard_stops_yosys(module, params, name):
+    proc = elaborate(module, params)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0, f"yosys accepted {module} with {params}"
+    assert re.search(rf"ERROR.*\b\w*{name}\w*\b", out), \
+        f"yosys stopped {module} {params} without naming {name}:\n{out}"

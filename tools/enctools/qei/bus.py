@@ -6,10 +6,11 @@ enctools.qei.stimulus."""
 
 from __future__ import annotations
 
+import copy
 import logging
 import random
 
-from enctools.regmap import addr, event_names
+from enctools.regmap import addr, event_names, regmap
 
 PERIOD_PS = 10_000  # 100 MHz
 T_NS = PERIOD_PS / 1000
@@ -31,6 +32,7 @@ class QeiBus:
     def __init__(self, dut, rng: random.Random | None = None, offsets: dict | None = None):
         self.dut = dut
         self.offsets = offsets
+        self.chan = 0  # the channel page that register names refer to (see at())
         rng = rng or random.Random(1)
         self.kind = "axil" if hasattr(dut, "s_axil_awaddr") else "wb"
         if self.kind == "wb":
@@ -78,9 +80,18 @@ class QeiBus:
         resp = await self.m.write(offset + lanes[0], data_bytes)
         return int(resp.resp) != 0
 
+    def at(self, chan: int) -> "QeiBus":
+        """The same bus, its register names meaning channel ``chan``'s registers (global
+        registers stay on page 0). Views share the master, so their accesses queue in order."""
+        view = copy.copy(self)
+        view.chan = chan
+        return view
+
     # convenience, by register name
     def offset(self, reg: str) -> int:
-        return self.offsets[reg] if self.offsets is not None else addr(reg)
+        if self.offsets is not None:
+            return self.offsets[reg]
+        return addr(reg, self.chan if regmap()[reg].group == "chan" else 0)
 
     async def rd(self, reg: str) -> int:
         value, err = await self.read(self.offset(reg))

@@ -17,14 +17,16 @@ from __future__ import annotations
 
 import cocotb
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
-from cocotbext.quadrature import QuadratureDriver
+from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel import QUAD
 
 from enctools.qei.bus import PERIOD_PS, QeiBus
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import FILTER
-from enctools.regmap import pack
+from enctools.regmap import enum, pack
 from enctools.tb import start
+
+PROFILE_LEAN = enum("CAPS", "PROFILE")["lean"]
 
 # ---- configurations and the pytest side -----------------------------------------------------------
 CONFIGS = (("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16))  # (top, COUNT_W, TS_W)
@@ -46,12 +48,17 @@ def run_feature(module: str, top: str, count_w: int, ts_w: int):
 
 # ---- the environment -------------------------------------------------------------------------------
 class Env:
-    def __init__(self, dut, rng):
+    """One channel's environment: ``bus`` and ``drv`` default to channel 0's (see
+    channel_envs() for every channel of a multi-channel build)."""
+
+    def __init__(self, dut, rng, bus: QeiBus | None = None, drv: QuadratureDriver | None = None):
         self.dut, self.rng = dut, rng
-        self.bus = QeiBus(dut, rng)
+        self.bus = bus or QeiBus(dut, rng)
         self.count_w = int(dut.COUNT_W.value)
-        self.drv = QuadratureDriver(dut.a_in, dut.b_in, dut.z_in, clock_period_ps=PERIOD_PS)
+        self.drv = drv or QuadratureDriver(dut.a_in, dut.b_in, dut.z_in, clock_period_ps=PERIOD_PS)
         self.pos = 0  # 4X position of the stimulus now
+        # the lean profile has no compare unit (and no range modes: its count is free-running)
+        self.lean = int(dut.PROFILE.value) == PROFILE_LEAN
 
     async def settle(self, clocks: int = 12):
         await ClockCycles(self.dut.clk, clocks)
@@ -62,9 +69,11 @@ class Env:
         model.range = rng_mode
         model.ceiling = model.max if ceiling is None else ceiling
         model.compare = 0 if compare is None else compare
+        if self.lean:  # (CEILING and COMPARE are still written: they must have no effect)
+            model.compare = None
         model.en = bool(en)
         await bus.set64("CEILING", model.ceiling)
-        await bus.set64("COMPARE", model.compare)
+        await bus.set64("COMPARE", model.compare or 0)
         ctrl = pack("CTRL", EN=en, FUNC=func, RANGE=rng_mode, FILTER_LEN=filter_len)
         await bus.wr("CTRL", ctrl)
         model.set_func(func, QUAD[self.pos % 4])
@@ -98,6 +107,17 @@ class Env:
             ev = await self.bus.events()
             exp = model.take_events()
             assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
+
+
+def channel_envs(dut, rng, channels: int) -> list[Env]:
+    """One Env per channel: its register page (QeiBus.at) and its own bits of the vector inputs
+    a_in / b_in / z_in (cocotbext.quadrature.SharedVector), so that every channel can play its
+    own waveform at the same time."""
+    bus = QeiBus(dut, rng)
+    a, b, z = SharedVector(dut.a_in), SharedVector(dut.b_in), SharedVector(dut.z_in)
+    return [Env(dut, rng, bus=bus.at(k),
+                drv=QuadratureDriver(a.bit(k), b.bit(k), z.bit(k), clock_period_ps=PERIOD_PS))
+            for k in range(channels)]
 
 
 async def begin(dut):

@@ -37,7 +37,7 @@ class QeiModel:
         self.range = "free"
         self.en = True
         self.ceiling = self.max
-        self.compare = 0
+        self.compare = 0  # None: a build without the compare unit (PROFILE lean)
         self.count = 0
         self.stopped = False
         self.dir = 1
@@ -202,6 +202,6 @@ class QeiModel:
                 self._changed()
 
     def _changed(self) -> None:
-        if self.count == self.compare:
+        if self.compare is not None and self.count == self.compare:  # None: no compare unit
             self.events.add("CMP")
             self.cmp_hits += 1

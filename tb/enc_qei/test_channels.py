@@ -1,0 +1,318 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei with several channels behind one bus: every channel counting its own modelled walk at
+the same time, isolation of the channel pages, the map of a multi-channel build (CAPS, pages,
+unmapped offsets), the global snapshot (by GSNAP_CTRL.CMD, by snap_in, by the unit timer; every
+channel latched in one clock, SNAP_TIME shared) and IRQ_SUMMARY.
+
+Runs on CHANNEL_CONFIGS (enc_qei_wb with 3 full channels, enc_qei_axil with 4 lean ones, random
+AXI back-pressure). Each channel has its own model (enctools.qei.model); a lean channel's model
+has no compare unit. Every cocotb test logs its seed (make test SEED=n reproduces a run).
+"""
+
+from __future__ import annotations
+
+import cocotb
+import pytest
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotbext.quadrature import QuadratureDriver, SharedVector
+from hedsmodel import QUAD, random_walk
+
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
+from enctools.qei.env import FILTER, begin, build_name, channel_envs
+from enctools.qei.model import QUAD_FUNCS, QeiModel
+from enctools.regmap import PAGE, addr, enum, get_field, pack, regmap
+from enctools.tb import cocotb_test
+
+# (top, CHANNELS, PROFILE, COUNT_W, TS_W)
+CHANNEL_CONFIGS = (("enc_qei_wb", 3, "full", 32, 32), ("enc_qei_axil", 4, "lean", 32, 32))
+SNAP_REGS = ("SNAP_COUNT_LO", "SNAP_COUNT_HI", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA",
+             "SNAP_EDGE_DELTA")
+CHAN_REGS = tuple(n for n, r in regmap().items() if r.group == "chan")
+SNAP_READY = regmap()["EVENTS"].fields["SNAP_READY"].mask
+
+
+def channels_of(dut) -> int:
+    return int(dut.CHANNELS.value)
+
+
+async def start_channels(dut):
+    """The clock, the reset, and one Env per channel."""
+    _, rng = await begin(dut)
+    return channel_envs(dut, rng, channels_of(dut)), rng
+
+
+async def set_index(env, model, rng) -> None:
+    """A random INDEX_CTRL action on one channel (and its model)."""
+    action = rng.choice(("none", "preset", "latch"))
+    preset = rng.getrandbits(20)
+    await env.bus.set64("PRESET", preset)
+    await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
+    model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, action, "rising", True
+    model.idx_gate, model.idx_oneshot = None, False
+
+
+@cocotb_test()
+async def independent_walks(dut):
+    """Every channel plays its own random walk (runs at the count-rate bound, dither, index pulses)
+    at the same time, with its own count function and index action; each channel's COUNT, EVENTS
+    and INDEX_LATCH are checked against its own model."""
+    envs, rng = await start_channels(dut)
+    models = [QeiModel(env.count_w) for env in envs]
+    funcs = [rng.choice(QUAD_FUNCS) for _ in envs]
+    for env, model, func in zip(envs, models, funcs):
+        await env.setup(model, func=func, count=rng.getrandbits(env.count_w))
+        await set_index(env, model, rng)
+    dut._log.info("count functions per channel: %s", funcs)
+    for rnd in range(4):
+        tasks = []
+        for k, (env, model) in enumerate(zip(envs, models)):
+            p_rev = rng.choice((0.02, 0.2, 0.5))
+            # rounds 0 and 1 at the count-rate bound (states of 1.05 max(1, F/2) clocks and up)
+            shortest = 1.05 * max(1, FILTER / 2) if rnd < 2 else 1.05 * FILTER
+            wf = random_walk(rng, rng.randint(80, 200), shortest * T_NS + 0.01,
+                             2 * shortest * T_NS, p_reverse=p_rev, start_pos=env.pos)
+            period = rng.choice((24, 40, 64))
+            # (at the bound a reversal makes one-state pulses, shorter than the filter: no index
+            # there, and the filter's GLITCH flag is expected)
+            zf = (lambda p, n=period: int(5 <= p % n <= 7)) if rnd >= 2 else None
+            tasks.append(cocotb.start_soon(env.play(wf, model, zfun=zf)))
+        for t in tasks:
+            await t
+        for k, (env, model) in enumerate(zip(envs, models)):
+            what = f"channel {k} ({funcs[k]}), round {rnd}"
+            await env.check(model, what, events=False)
+            ev, exp = await env.bus.events(), model.take_events()
+            if rnd < 2:
+                ev.discard("GLITCH")
+            assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
+            latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
+            assert latch == model.idx_latch, \
+                f"channel {k}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
+    dut._log.info("final counts: %s", [hex(m.count) for m in models])
+
+
+async def dump(bus: QeiBus, k: int) -> dict:
+    """Every channel register of channel k (reads have no side effect on another channel)."""
+    view = bus.at(k)
+    return {reg: await view.rd(reg) for reg in CHAN_REGS}
+
+
+CONTIGUOUS_STRB = (1, 2, 4, 8, 3, 6, 12, 7, 14, 15)  # (AXI4-Lite: contiguous lanes)
+
+
+@cocotb_test()
+async def isolation(dut):
+    """Random register traffic to channel k (writes of random values and byte lanes to every
+    channel register, commands included, and reads) never changes any register of any other
+    channel. After its traffic channel k is put back to quiet (no timers, no stall watchdog), so
+    nothing in it runs on by itself."""
+    envs, rng = await start_channels(dut)
+    bus = envs[0].bus
+    n = len(envs)
+    for k in rng.sample(range(n), n):
+        others = [j for j in range(n) if j != k]
+        before = {j: await dump(bus, j) for j in others}
+        view = bus.at(k)
+        for _ in range(60):
+            reg = rng.choice(CHAN_REGS)
+            if rng.random() < 0.25:
+                await view.rd(reg)
+            else:
+                await view.wr(reg, rng.getrandbits(32), strb=rng.choice(CONTIGUOUS_STRB))
+        for reg in ("SNAP_CTRL", "PERIOD_CTRL", "STALL_TIMEOUT"):
+            await view.wr(reg, 0)
+        for j in others:
+            after = await dump(bus, j)
+            changed = {r: (hex(before[j][r]), hex(after[r])) for r in CHAN_REGS
+                       if before[j][r] != after[r]}
+            assert not changed, f"traffic to channel {k} changed channel {j}: {changed}"
+    dut._log.info("%d channels: every register of every other channel unchanged", n)
+
+
+@cocotb_test()
+async def channel_map(dut):
+    """CAPS names the channels and the profile; every page below CHANNELS answers its channel
+    registers, a global offset in a page other than 0 and every page at or above CHANNELS answer
+    a bus error; IRQ_SUMMARY bits at and above CHANNELS read 0."""
+    envs, rng = await start_channels(dut)
+    bus = envs[0].bus
+    n = channels_of(dut)
+    caps = await bus.rd("CAPS")
+    assert get_field("CAPS", "CHANNELS", caps) == n, f"CAPS {caps:#x}: CHANNELS is not {n}"
+    profile = {v: k for k, v in enum("CAPS", "PROFILE").items()}[get_field("CAPS", "PROFILE", caps)]
+    assert profile == PROFILE_OF[int(dut.PROFILE.value)], f"CAPS.PROFILE {profile}"
+    version = get_field("ID", "VERSION", await bus.rd("ID"))
+    assert version >= 0x0101, f"ID.VERSION {version:#06x}: a multi-channel map is 0x0101 or later"
+    pages = 1 << (int(dut.ADDR_W.value) - 8)  # the pages the address reaches
+    glb = [r for r, x in regmap().items() if x.group == "glb"]
+    for k in range(1, n):
+        for reg in rng.sample(glb, 3):
+            _, err = await bus.read(k * PAGE + regmap()[reg].offset)
+            assert err, f"{reg}'s offset in page {k} answered without an error"
+        # a channel register of page k is channel k's: a PRESET written there reads back there only
+        value = rng.getrandbits(32)
+        await bus.at(k).wr("PRESET_LO", value)
+        assert await bus.at(k).rd("PRESET_LO") == value
+        assert await bus.at(k - 1).rd("PRESET_LO") != value or value == 0
+    for k in range(n, min(pages, 16)):
+        _, err = await bus.read(k * PAGE + regmap()["COUNT_LO"].offset)
+        assert err, f"page {k} (CHANNELS {n}) answered a read without an error"
+        err = await bus.write(k * PAGE + regmap()["CTRL"].offset, 0)
+        assert err, f"page {k} (CHANNELS {n}) answered a write without an error"
+    assert await bus.rd("IRQ_SUMMARY") == 0
+
+
+PROFILE_OF = {v: k for k, v in enum("CAPS", "PROFILE").items()}
+
+
+async def read_all(envs) -> list[dict]:
+    return [dict(zip(SNAP_REGS, [await env.bus.rd(r) for r in SNAP_REGS])) for env in envs]
+
+
+def check_same_instant(snaps, gtime, offsets, what, mask=(1 << 32) - 1):
+    """Every channel's snapshot from one clock: SNAP_TIME = GSNAP_TIME everywhere, the counts
+    apart by exactly their starting offsets (modulo 2^COUNT_W: ``mask``), the edge times and
+    deltas equal."""
+    base = snaps[0]
+    for k, s in enumerate(snaps):
+        assert s["SNAP_TIME"] == gtime, f"{what}: channel {k} SNAP_TIME {s['SNAP_TIME']:#x}, " \
+                                        f"GSNAP_TIME {gtime:#x}"
+        count = (s["SNAP_COUNT_HI"] << 32 | s["SNAP_COUNT_LO"]) - offsets[k] & mask
+        count0 = (base["SNAP_COUNT_HI"] << 32 | base["SNAP_COUNT_LO"]) - offsets[0] & mask
+        assert count == count0, f"{what}: channel {k} read position {count}, channel 0 {count0}"
+        for r in ("SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA"):
+            assert s[r] == base[r], f"{what}: channel {k} {r} {s[r]:#x}, channel 0 {base[r]:#x}"
+
+
+async def take_ready(envs, what) -> None:
+    """Every channel raised SNAP_READY; clear it."""
+    for k, env in enumerate(envs):
+        ev = await env.bus.rd("EVENTS")
+        assert ev & SNAP_READY, f"{what}: channel {k} has no SNAP_READY (EVENTS {ev:#x})"
+        await env.bus.wr("EVENTS", SNAP_READY)
+
+
+@cocotb_test()
+async def global_snapshot(dut):
+    """One shared motion on every channel (each count offset by 1000 k): snapshots by
+    GSNAP_CTRL.CMD, by a rising snap_in (IN_EN; none without it) and by the unit timer
+    (consecutive GSNAP_TIMEs exactly GSNAP_PERIOD apart) read the same position on every channel,
+    with one SNAP_TIME equal to GSNAP_TIME, and raise SNAP_READY on every channel."""
+    envs, rng = await start_channels(dut)
+    n = len(envs)
+    bus = envs[0].bus
+    a, b = SharedVector(dut.a_in), SharedVector(dut.b_in)
+    drv = QuadratureDriver(a.all_bits(), b.all_bits(), clock_period_ps=PERIOD_PS)
+    offsets = [1000 * k for k in range(n)]
+    for env, off in zip(envs, offsets):
+        await env.setup(QeiModel(env.count_w), func="x4", count=off)
+        await env.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE=rng.choice(("any", "a_rising"))))
+    edges = [await env.bus.rd("SNAP_CTRL") for env in envs]
+    if len(set(edges)) > 1:  # one SNAP_CTRL.EDGE for all, so that the edge times compare
+        for env in envs:
+            await env.bus.wr("SNAP_CTRL", edges[0])
+
+    def motion(steps: int):
+        return drv.start(random_walk(rng, steps, 1.05 * FILTER * T_NS + 0.1, 2 * FILTER * T_NS,
+                                     p_reverse=0.1, start_pos=0))
+
+    # by command, while moving
+    task = motion(3000)
+    for i in range(6):
+        await ClockCycles(dut.clk, rng.randint(50, 400))
+        await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+        snaps = await read_all(envs)
+        check_same_instant(snaps, await bus.rd("GSNAP_TIME"), offsets, f"CMD snapshot {i}")
+        await take_ready(envs, f"CMD snapshot {i}")
+    # by snap_in: none while IN_EN = 0, one per rising edge with it
+    last = await bus.rd("GSNAP_TIME")
+    await pulse_snap_in(dut, rng)
+    assert await bus.rd("GSNAP_TIME") == last, "snap_in with IN_EN = 0 took a global snapshot"
+    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", IN_EN=1))
+    for i in range(4):
+        await ClockCycles(dut.clk, rng.randint(20, 300))
+        t_in = await pulse_snap_in(dut, rng)
+        gtime = await bus.rd("GSNAP_TIME")
+        assert gtime == t_in, f"snap_in snapshot {i}: GSNAP_TIME {gtime:#x}, timebase in the " \
+                              f"clock snap_in was first high {t_in:#x}"
+        check_same_instant(await read_all(envs), gtime, offsets, f"snap_in snapshot {i}")
+        await take_ready(envs, f"snap_in snapshot {i}")
+    await bus.wr("GSNAP_CTRL", 0)
+    await task
+    # by the unit timer
+    period = 3000
+    await bus.wr("GSNAP_PERIOD", period)
+    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+    task = motion(8000)
+    times = []
+    while len(times) < 5:
+        await ClockCycles(dut.clk, 100)
+        if not await envs[0].bus.rd("EVENTS") & SNAP_READY:
+            continue
+        gtime = await bus.rd("GSNAP_TIME")
+        await take_ready(envs, f"timer snapshot {len(times)}")
+        check_same_instant(await read_all(envs), gtime, offsets, f"timer snapshot {len(times)}")
+        assert await bus.rd("GSNAP_TIME") == gtime, "the unit timer fired again during the reads"
+        times.append(gtime)
+    await bus.wr("GSNAP_CTRL", 0)
+    gaps = [(t1 - t0) % (1 << 32) for t0, t1 in zip(times, times[1:])]
+    assert all(g == period for g in gaps), f"unit-timer snapshots {gaps} ticks apart, not {period}"
+    await task
+    dut._log.info("global snapshots: 6 by command, 4 by snap_in, 5 by the timer (%s)", times)
+
+
+async def pulse_snap_in(dut, rng) -> int:
+    """snap_in high for a few clocks (set after a falling edge); returns the timebase in the clock
+    it is first high (the clock that begins with the rising edge that first samples it high)."""
+    await FallingEdge(dut.clk)
+    dut.snap_in.value = 1
+    await RisingEdge(dut.clk)
+    await ReadOnly()
+    t = int(dut.u_qei.g_timebase.u_timebase.timebase.value)
+    await ClockCycles(dut.clk, rng.randint(1, 4))
+    await FallingEdge(dut.clk)
+    dut.snap_in.value = 0
+    await ClockCycles(dut.clk, 4)
+    return t
+
+
+@cocotb_test()
+async def irq_summary(dut):
+    """IRQ_SUMMARY has the pending bit of exactly the channels with an event their IRQ_EN enables
+    (events raised by each channel's own SNAP_CTRL.CMD), and irq is their OR; clearing a channel's
+    event clears its bit."""
+    envs, rng = await start_channels(dut)
+    n = len(envs)
+    bus = envs[0].bus
+    for trial in range(8):
+        en = [rng.choice((0, SNAP_READY, 0xFFF)) for _ in envs]
+        for env, e in zip(envs, en):
+            await env.bus.wr("IRQ_EN", e)
+            await env.bus.wr("EVENTS", 0xFFF)
+        hit = set(rng.sample(range(n), rng.randint(0, n)))
+        for k in sorted(hit):
+            await envs[k].bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+        await ClockCycles(dut.clk, 4)
+        exp = sum(1 << k for k in hit if en[k] & SNAP_READY)
+        got = await bus.rd("IRQ_SUMMARY")
+        assert got == exp, f"trial {trial}: IRQ_SUMMARY {got:#x}, expected {exp:#x} " \
+                           f"(snapshots on {sorted(hit)}, IRQ_EN {[hex(e) for e in en]})"
+        assert int(dut.irq.value) == int(exp != 0), f"trial {trial}: irq {int(dut.irq.value)}"
+        for k in rng.sample(sorted(hit), len(hit) // 2):
+            await envs[k].bus.wr("EVENTS", SNAP_READY)
+            exp &= ~(1 << k)
+        got = await bus.rd("IRQ_SUMMARY")
+        assert got == exp, f"trial {trial}, after clearing: IRQ_SUMMARY {got:#x}, expected {exp:#x}"
+    for env in envs:
+        await env.bus.wr("IRQ_EN", 0)
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,channels,profile,count_w,ts_w", CHANNEL_CONFIGS,
+                         ids=[f"{t}-ch{c}-{p}" for t, c, p, _, _ in CHANNEL_CONFIGS])
+def test_channels(top, channels, profile, count_w, ts_w):
+    from enctools.harness import run
+
+    code = enum("CAPS", "PROFILE")[profile]
+    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}",
+        parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code})
