@@ -307,7 +307,7 @@ async def irq_summary(dut):
         await env.bus.wr("IRQ_EN", 0)
 
 
-# ---- pytest ---------------------------------------------------------------------------------------
+# ---- pytest --------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,channels,profile,count_w,ts_w", CHANNEL_CONFIGS,
                          ids=[f"{t}-ch{c}-{p}" for t, c, p, _, _ in CHANNEL_CONFIGS])
 def test_channels(top, channels, profile, count_w, ts_w):

@@ -18,7 +18,8 @@ CASES = list(guard_cases())
 # limits between parameters, which a range cannot express: (module, parameters, ok, the name the
 # message must contain). enc_qei's address must reach every channel's page; a lean channel's count
 # is at least 32 bits (its free-running count is the one a driver extends).
-RELATIONAL = [(top, params, ok, name) for top in ("enc_qei_wb", "enc_qei_axil") for params, ok, name in (
+RELATIONAL = [(top, params, ok, name) for top in ("enc_qei_wb", "enc_qei_axil")
+              for params, ok, name in (
     ({"CHANNELS": 2, "ADDR_W": 8}, False, "ADDR_W"),
     ({"CHANNELS": 16, "ADDR_W": 11}, False, "ADDR_W"),
     ({"CHANNELS": 16, "ADDR_W": 12}, True, ""),
