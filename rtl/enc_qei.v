@@ -228,13 +228,14 @@ module enc_qei #(
   generate
     for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
       enc_qei_channel #(
-          .COUNT_W  (COUNT_W),
-          .TS_W     (TS_W),
-          .FUNC_MASK(FUNC_MASK),
-          .TIMING   (TIMING),
-          .RANGE    (RANGE),
-          .PROBE    (PROBE),
-          .PERIOD   (PERIOD)
+          .COUNT_W   (COUNT_W),
+          .TS_W      (TS_W),
+          .FUNC_MASK (FUNC_MASK),
+          .FIXED_FUNC(FIXED_FUNC),
+          .TIMING    (TIMING),
+          .RANGE     (RANGE),
+          .PROBE     (PROBE),
+          .PERIOD    (PERIOD)
       ) u_chan (
           .clk     (clk),
           .rst     (rst),

@@ -22,6 +22,7 @@ module enc_qei_channel #(
     parameter integer COUNT_W    = 32,   // counter width (checked by enc_qei)
     parameter integer TS_W       = 32,   // timebase width (checked by enc_qei)
     parameter integer FUNC_MASK  = 511,  // count functions built (checked by enc_qei)
+    parameter integer FIXED_FUNC = -1,   // the one function FUNC_MASK builds, or -1 (from enc_qei)
     parameter integer TIMING     = 1,    // units, as enc_qei_regs's (checked by enc_qei)
     parameter integer RANGE      = 1,
     parameter integer PROBE      = 1,
@@ -46,21 +47,6 @@ module enc_qei_channel #(
   `include "enc_qei_regs.vh"
   `include "enc_qei_chan_fields.vh"
 
-  // The code of the one count function FUNC_MASK builds, or -1 when it builds several.
-  function integer single_func;
-    input integer mask;
-    integer f;
-    begin
-      single_func = -1;
-      for (f = 0; f < ENC_QEI_FUNC_N; f = f + 1) begin
-        if (mask == (1 << f)) begin
-          single_func = f;
-        end
-      end
-    end
-  endfunction
-
-  localparam integer FIXED_FUNC  = single_func(FUNC_MASK);
   localparam integer FUNC_ALL    = (1 << ENC_QEI_FUNC_N) - 1;
   localparam [15:0]  FUNC_MASK16 = FUNC_MASK[15:0];
 
