@@ -16,6 +16,7 @@
 // It asserts the one rule enc_qei sets its user (rtl/enc_qei_regs.v): one request at a time, a
 // new one only from the clock after the previous one's resp_valid.
 `default_nettype none
+`include "enc_params.vh"
 
 module enc_qei #(
     parameter integer CHANNELS   = 1,
@@ -23,7 +24,7 @@ module enc_qei #(
     parameter integer COUNT_W    = 32,
     parameter integer TS_W       = 32,
     parameter integer PROFILE    = 2,
-    parameter integer FUNC_MASK  = 511
+    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL
 ) (
     input  wire        clk,
     input  wire        rst,

@@ -22,7 +22,7 @@ module enc_qei_port_formal #(
     parameter integer COUNT_W   = 32,
     parameter integer TS_W      = 32,
     parameter integer PROFILE   = 2,
-    parameter integer FUNC_MASK = 511,
+    parameter integer FUNC_MASK = `ENC_QEI_FUNC_ALL,
     parameter integer CHANNELS  = 1,
     parameter integer AW        = `ENC_QEI_ADDR_W(CHANNELS)  // byte address bits
 ) (

@@ -39,6 +39,8 @@
 `define ENC_CHECK_PHASE_WINDOW_LOG2 if (PHASE_WINDOW_LOG2 < 8 || PHASE_WINDOW_LOG2 > 24) begin : g_bad_phase_window_log2 $error("parameter PHASE_WINDOW_LOG2 must be in 8 .. 24"); end
 `define ENC_CHECK_CLKS_PER_BIT if (CLKS_PER_BIT < 2 || CLKS_PER_BIT > 65535) begin : g_bad_clks_per_bit $error("parameter CLKS_PER_BIT must be in 2 .. 65535"); end
 `endif
+// Every count function (CTRL.FUNC's codes in rtl/enc_qei.rdl): the default of FUNC_MASK
+`define ENC_QEI_FUNC_ALL 511
 // The least byte-address width that holds CHANNELS pages of 256 bytes (the default of ADDR_W)
 `define ENC_QEI_ADDR_W(CH) (((CH) > 8) ? 12 : (((CH) > 4) ? 11 : (((CH) > 2) ? 10 : (((CH) > 1) ? 9 : (8)))))
 // One channel's register bundles (rtl/enc_qei_chan_fields.vh): reg2hw and hw2reg widths

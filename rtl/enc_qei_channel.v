@@ -21,7 +21,7 @@
 module enc_qei_channel #(
     parameter integer COUNT_W    = 32,   // counter width (checked by enc_qei)
     parameter integer TS_W       = 32,   // timebase width (checked by enc_qei)
-    parameter integer FUNC_MASK  = 511,  // count functions built (checked by enc_qei)
+    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL,  // count functions built (checked by enc_qei)
     parameter integer FIXED_FUNC = -1,   // the one function FUNC_MASK builds, or -1 (from enc_qei)
     parameter integer TIMING     = 1,    // units, as enc_qei_regs's (checked by enc_qei)
     parameter integer RANGE      = 1,

@@ -17,7 +17,7 @@ module enc_qei_wb #(
     parameter integer COUNT_W    = 32,  // counter width in bits
     parameter integer TS_W       = 32,  // timebase / timestamp width in bits
     parameter integer PROFILE    = 2,   // 2 full, 1 counting, 3 lean (see enc_qei)
-    parameter integer FUNC_MASK  = 511  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
+    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL  // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,       // synchronous, active high

@@ -31,12 +31,7 @@ TOP = Path(__file__).resolve().parents[2]
 # Links that are broken in files this test's owner may not edit, with the reason. The test of such
 # a file reports xfail while they stay broken, fails on any other broken link in it, and fails
 # when a listed link resolves again (remove it here then).
-KNOWN_BROKEN: dict[str, set[str]] = {
-    "doc/testplan.md": {
-        "../tb/common/decoder_bench.py",  # moved to tools/enctools/tb/decoder_bench.py
-        "../tb/common/models.py",  # moved to tools/enctools/tb/models.py
-    },
-}
+KNOWN_BROKEN: dict[str, set[str]] = {}
 
 FENCE = re.compile(r"^\s*(```|~~~)")
 CODE_SPAN = re.compile(r"(`+)(?:(?!\1).)+?\1")

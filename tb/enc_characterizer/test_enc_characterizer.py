@@ -198,7 +198,7 @@ async def slow_units_wide_states(dut):
     """A slow shaft: 2300 clocks per cycle, states of 450 to 750 clocks, so the upper bits of
     the state, pulse, phase and period registers carry data (the other tests run 150 to 400
     clocks per cycle: no state reaches 512 clocks, and a stuck bit 9 of the widest-state register
-    went unseen in the mutation run, issue 14). Within the state counter's range (2^CNT_W - 2
+    went unseen by mutation testing). Within the state counter's range (2^CNT_W - 2
     clocks; CNT_W >= 11 for this speed)."""
     await start_clock(dut)
     if int(dut.CNT_W.value) < 11:

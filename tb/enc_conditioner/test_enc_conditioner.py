@@ -185,7 +185,7 @@ async def reset_on_rejection_clock(dut):
     both), each rejected width 1 .. FILTER_LEN-1 samples, the reset is swept over every clock from
     the pulse's first sample to past its rejection, so exactly one of the sweeps lands on the
     rejection clock; the test counts those. Deterministic: random resets hit that clock only on
-    some seeds (mutation run, issue 14). FILTER_LEN = 1 rejects nothing: only the sweep runs."""
+    some seeds. FILTER_LEN = 1 rejects nothing: only the sweep runs."""
     f = int(dut.FILTER_LEN.value)
     checker = await start(dut)
     model = checker.model

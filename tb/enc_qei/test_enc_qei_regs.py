@@ -75,7 +75,8 @@ def test_rdl_has_the_contract_names():
     def enum(reg, field):
         return {m.name for m in regs[reg].get_child_by_name(field).get_property("encode")}
 
-    assert enum("CTRL", "FUNC") == {"x4", "x2a", "x2b", "x1a", "x1b", "pulse_dir", "increase",
+    # the contract's functions (a build may add more)
+    assert enum("CTRL", "FUNC") >= {"x4", "x2a", "x2b", "x1a", "x1b", "pulse_dir", "increase",
                                     "decrease", "x1_hyst"}
     assert enum("CTRL", "RANGE") == {"free", "modulo", "limit", "non_recycle"}
     assert enum("INDEX_CTRL", "ACTION") == {"none", "preset", "latch"}

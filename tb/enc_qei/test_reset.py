@@ -67,8 +67,8 @@ async def reset_mid_motion(dut):
 async def reset_in_each_state(dut):
     """rst with the shaft standing in each of the four states (inputs held through the reset):
     the peripheral takes that state as its reference: count 0, no QERR, no GLITCH; then it counts
-    exactly from there. (Written as the reproducer of a bug make mutate led to: `valid` rose one
-    clock before the conditioner showed the inputs; fixed in enc_conditioner_rt, d197bf9.)"""
+    exactly from there. (`valid` must not rise a clock before the conditioner shows the inputs,
+    or the first state is taken as a step.)"""
     env, rng = await begin(dut)
     bus = env.bus
     for pos in (2, 1, 3, 0, 2):

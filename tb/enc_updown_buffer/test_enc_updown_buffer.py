@@ -229,7 +229,7 @@ async def rd_data_at_the_top(dut):
     """Below zero every digit is MODULUS-1, so the high bits of every digit are set: count AND
     rd_data read the wrapped value at each stop of a walk across zero; then hold freezes rd_data at
     such a value while the count moves back up past zero, and rd_data catches up after hold.
-    (Mutation run, issue 14: rd_data's upper digits were never compared at a non-zero value.)"""
+    (rd_data's upper digits were never compared at a non-zero value.)"""
     buf = await start(dut)
     dwell = 2.4 * buf.f * T_NS + 2 * T_NS  # every state longer than the filter
 
@@ -265,7 +265,7 @@ async def rd_data_at_the_top(dut):
 async def glitch_reaches_output(dut):
     """A one-sample pulse on a_in or b_in is rejected by the conditioner (FILTER_LEN > 1): one
     `glitch` pulse at the buffer's output each, no count, no error. With FILTER_LEN = 1 the pulse
-    passes (A up and back: net count 0) and glitch stays 0. (Mutation run, issue 14: the other
+    passes (A up and back: net count 0) and glitch stays 0. (The other
     tests only check that glitch stays 0, so a glitch output tied to 0 passed them.)"""
     buf = await start(dut)
     flags = FlagCounter(dut)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Issue 4: sweeps of the counting circuits driven by the HEDS-5000 model at the 12 MHz clock.
+"""Sweeps of the counting circuits driven by the HEDS-5000 model at the 12 MHz clock.
 
 DUT: tb/hdl/enc_quad_probe.v (enc_conditioner -> enc_x4_decoder, enc_x2_xor, enc_x1_hysteresis
 with net-count accumulators and flag counters), built with FILTER_LEN = 3 (the default) and 1

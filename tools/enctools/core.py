@@ -95,8 +95,8 @@ def ranges() -> dict[str, ParamRange]:
     out = {}
     for name, spec in data.items():
         if "range" in spec:
-            lo, hi = spec["range"]
-            out[name] = ParamRange(name, int(lo), int(hi))
+            lo, hi = (_symbol(v) for v in spec["range"])
+            out[name] = ParamRange(name, lo, hi)
         elif "values" in spec:
             out[name] = ParamRange(name, values=tuple(int(v) for v in spec["values"]))
         else:
@@ -104,6 +104,16 @@ def ranges() -> dict[str, ParamRange]:
         if name not in core()["parameters"]:
             raise ValueError(f"enc_ip.core: enc_params.{name} is not a declared parameter")
     return out
+
+
+def _symbol(value) -> int:
+    """A range end: a number, or ``func_all`` (every CTRL.FUNC code of rtl/enc_qei.rdl's enum: the
+    all-ones FUNC_MASK, so that a new count function widens FUNC_MASK's range by itself)."""
+    if value == "func_all":
+        from .regmap import enum
+
+        return max(1 << v for v in enum("CTRL", "FUNC").values()) * 2 - 1
+    return int(value)
 
 
 def param_range(name: str) -> ParamRange:

@@ -110,7 +110,7 @@ BLOCKS = [
     Block("enc_qei_axil", {"COUNT_W": 32}, device="ecp5", seeds=3),
     Block("enc_qei_wb", {"COUNT_W": 16}, device="ecp5", seeds=3),
     Block("enc_qei_axil", {"COUNT_W": 16}, device="ecp5", seeds=3),
-    # issue 12's peripheral alone (issue 13's timing unit left out): the 1,500 LUT4 goal
+    # the counting peripheral alone (PROFILE 1: no timing unit): the 1,500 LUT4 goal
     Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 1}, lut_goal=1500, fmax_goal=100.0, seeds=3),
     Block("enc_qei_axil", {"COUNT_W": 32, "PROFILE": 1}, lut_goal=1500, fmax_goal=100.0, seeds=3),
     # COUNT_W 16 with the function fixed (FUNC_MASK 1: x4 only), no timing unit: the row to

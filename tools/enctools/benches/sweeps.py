@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Shared logic of the counting-circuit sweeps (issue 4): tb/sweeps/test_sweeps.py and scripts/sweep.py.
+"""Shared logic of the counting-circuit sweeps: tb/sweeps/test_sweeps.py and scripts/sweep.py.
 
 A sweep *point* is one constant-speed run of one modelled HEDS-5000 unit (the hedsmodel package, python/) played
 into tb/hdl/enc_quad_probe.v (enc_conditioner -> enc_x4_decoder, enc_x2_xor, enc_x1_hysteresis,

@@ -41,6 +41,8 @@ def render() -> str:
         lines.append(f"`define ENC_CHECK_{r.name} if {cond} begin : g_bad_{r.name.lower()} "
                      f'$error("{msg}"); end')
     lines.append("`endif")
+    lines += ["// Every count function (CTRL.FUNC's codes in rtl/enc_qei.rdl): the default of FUNC_MASK",
+              f"`define ENC_QEI_FUNC_ALL {ranges['FUNC_MASK'].hi}"]
     lines += addr_w_default(ranges["CHANNELS"].hi)
     lines += bundle_widths()
     lines += ["`endif", ""]

@@ -221,7 +221,7 @@ async def reset_then_illegal_jump(dut):
     no count and no error pulse; then a short run is counted from it. From every state, for
     every step, and with the decoder's internal state before the reset varied (a run of k steps
     in either direction: a latched hysteresis state, a pending count). Deterministic: it catches
-    an `error` (or count) that ignores the reference flag on every seed (mutation run, issue 14)."""
+    an `error` (or count) that ignores the reference flag on every seed."""
     await start(dut)
     model = model_for(dut)
     for start_pos in range(4):
