@@ -117,7 +117,9 @@ module enc_qei_regs #(
   reg [7:0] rd_g_q, wr_g_q;  // a read / write of global register k (read-only ones: unused)
   // verilator lint_on UNUSEDSIGNAL
   reg [31:0] rd_c_q, wr_c_q;  // a read / write of channel register k, in the page of page_q
+  // verilator lint_off UNUSEDSIGNAL
   reg [CHANNELS-1:0] page_q;  // the request's page, one-hot (all 0: no channel's page)
+  // verilator lint_on UNUSEDSIGNAL
   reg        err_q;       // the request was to no register
   reg        pend_q;      // a request was made last clock
   reg [31:0] wdata_q;
@@ -152,6 +154,10 @@ module enc_qei_regs #(
   end
 
   wire [31:0] bmask = {{8{wstrb_q[3]}}, {8{wstrb_q[2]}}, {8{wstrb_q[1]}}, {8{wstrb_q[0]}}};
+
+  // The page gate of channel k's selects. With one channel, rd_c_q / wr_c_q are set only for
+  // requests to its page, so it needs no gate (and page_q is left unused).
+  wire [CHANNELS-1:0] page_hit = (CHANNELS == 1) ? {CHANNELS{1'b1}} : page_q;
 
   // ---- global registers ----------------------------------------------------------------
   reg [15:0] tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
@@ -214,8 +220,8 @@ module enc_qei_regs #(
   generate
     for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
       // verilator lint_off UNUSEDSIGNAL
-      wire [31:0] wr_c = wr_c_q & {32{page_q[ch]}};  // writes to this page
-      wire [31:0] rd_c = rd_c_q & {32{page_q[ch]}};  // reads of this page
+      wire [31:0] wr_c = wr_c_q & {32{page_hit[ch]}};  // writes to this page
+      wire [31:0] rd_c = rd_c_q & {32{page_hit[ch]}};  // reads of this page
       // verilator lint_on UNUSEDSIGNAL
       wire [385:0] r2h;
       wire [473:0] h2r = hw2reg_ch[ch*474 +: 474];
@@ -988,7 +994,7 @@ module enc_qei_regs #(
       rd_d[15:0] = rd_d[15:0] | hw2reg_g[106:91];  // IRQ_SUMMARY.PENDING
     end
     for (k = 0; k < CHANNELS; k = k + 1) begin
-      rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_q[k]}});
+      rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_hit[k]}});
     end
   end
 

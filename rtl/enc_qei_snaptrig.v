@@ -5,10 +5,11 @@
 // snapshot and a channel's own take their values in the same clock relative to their request.
 //
 // `req` is registered: high for one clock, the clock after the command, after the clock snap_in
-// is first high, or after the timer's tick at 0. The unit timer counts down from PERIOD - 1
+// is first high, or after the timer's last tick. The unit timer counts down from PERIOD to 1
 // (PERIOD 0 acts as 1) once per timebase tick and restarts when period_en rises and at each of
-// its requests; PERIOD - 1 and its zero test are registers (PERIOD acts one clock after it
-// changes; Fmax). TIMER = 0 leaves the timer out (period_en and period unused).
+// its requests, so a request comes every PERIOD ticks. PERIOD and its "at most 1" test are taken
+// into registers first (PERIOD acts one clock after it changes; Fmax: no arithmetic on the load
+// path). TIMER = 0 leaves the timer out (period_en and period unused).
 `default_nettype none
 
 module enc_qei_snaptrig #(
@@ -29,34 +30,35 @@ module enc_qei_snaptrig #(
 );
 
   localparam [TS_W-1:0] TS_ONE  = {{(TS_W-1){1'b0}}, 1'b1};
+  localparam [TS_W-1:0] TS_TWO  = {{(TS_W-2){1'b0}}, 2'b10};
   localparam [TS_W-1:0] TS_ZERO = {TS_W{1'b0}};
 
   wire unit_hit;
 
   generate
     if (TIMER != 0) begin : g_timer
-      reg  [TS_W-1:0] unit_q;
-      reg             unit_zero_q;       // unit_q == 0
-      reg  [TS_W-1:0] unit_load_q;       // PERIOD - 1 (0 for 0)
-      reg             unit_load_zero_q;  // ... == 0 (PERIOD 0 or 1)
+      reg  [TS_W-1:0] unit_q;           // ticks left in this period, PERIOD .. 1
+      reg             unit_last_q;      // unit_q <= 1: the next tick ends the period
+      reg  [TS_W-1:0] unit_load_q;      // PERIOD
+      reg             unit_load_last_q; // PERIOD <= 1 (0 acts as 1)
 
-      assign unit_hit = period_en & tick & unit_zero_q;
+      assign unit_hit = period_en & tick & unit_last_q;
 
       always @(posedge clk) begin
-        unit_load_q      <= (period == TS_ZERO) ? TS_ZERO : period - TS_ONE;
-        unit_load_zero_q <= (period[TS_W-1:1] == {(TS_W-1){1'b0}});
+        unit_load_q      <= period;
+        unit_load_last_q <= (period[TS_W-1:1] == {(TS_W-1){1'b0}});
       end
 
       always @(posedge clk) begin
         if (rst) begin
           unit_q      <= TS_ZERO;
-          unit_zero_q <= 1'b1;
+          unit_last_q <= 1'b1;
         end else if (~period_en | unit_hit) begin
           unit_q      <= unit_load_q;
-          unit_zero_q <= unit_load_zero_q;
+          unit_last_q <= unit_load_last_q;
         end else if (tick) begin
           unit_q      <= unit_q - TS_ONE;
-          unit_zero_q <= (unit_q == TS_ONE);
+          unit_last_q <= (unit_q == TS_TWO);
         end
       end
     end else begin : g_no_timer

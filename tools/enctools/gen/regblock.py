@@ -91,8 +91,8 @@ def render(top=None) -> str:
             "`endif",
             "  genvar ch;", "  generate", "    for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch"]
     inner = ["      // verilator lint_off UNUSEDSIGNAL",
-             f"      wire [{nc - 1}:0] wr_c = wr_c_q & {{{nc}{{page_q[ch]}}}};  // writes to this page",
-             f"      wire [{nc - 1}:0] rd_c = rd_c_q & {{{nc}{{page_q[ch]}}}};  // reads of this page",
+             f"      wire [{nc - 1}:0] wr_c = wr_c_q & {{{nc}{{page_hit[ch]}}}};  // writes to this page",
+             f"      wire [{nc - 1}:0] rd_c = rd_c_q & {{{nc}{{page_hit[ch]}}}};  // reads of this page",
              "      // verilator lint_on UNUSEDSIGNAL",
              f"      wire [{c.r2h_w - 1}:0] r2h;",
              f"      wire [{c.h2r_w - 1}:0] h2r = hw2reg_ch[ch*{c.h2r_w} +: {c.h2r_w}];",
@@ -109,7 +109,7 @@ def render(top=None) -> str:
             "  reg [31:0] rd_d;", "  integer k;", "", "  always @(*) begin", "    rd_d = 32'd0;"]
     out += fg.read_mux("rd_g_q", "rd_d")
     out += ["    for (k = 0; k < CHANNELS; k = k + 1) begin",
-            "      rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_q[k]}});", "    end", "  end", ""]
+            "      rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_hit[k]}});", "    end", "  end", ""]
     out += fg.formal_view("f_view_g", "rd_g_q")
     out += ["  reg        resp_valid_q;", "  reg [31:0] resp_rdata_q;", "  reg        resp_err_q;", "",
             "  always @(posedge clk) begin", "    if (rst) begin", "      resp_valid_q <= 1'b0;",
@@ -142,7 +142,9 @@ def decode(regs_g, regs_c) -> list[str]:
             f"  reg [{ng - 1}:0] rd_g_q, wr_g_q;  // a read / write of global register k (read-only ones: unused)",
             "  // verilator lint_on UNUSEDSIGNAL",
             f"  reg [{nc - 1}:0] rd_c_q, wr_c_q;  // a read / write of channel register k, in the page of page_q",
+            "  // verilator lint_off UNUSEDSIGNAL",
             "  reg [CHANNELS-1:0] page_q;  // the request's page, one-hot (all 0: no channel's page)",
+            "  // verilator lint_on UNUSEDSIGNAL",
             "  reg        err_q;       // the request was to no register", "  reg        pend_q;      // a request was made last clock",
             "  reg [31:0] wdata_q;", "  reg [3:0]  wstrb_q;", "  integer    p;", "",
             "  always @(posedge clk) begin", "    if (rst) begin",
@@ -158,5 +160,8 @@ def decode(regs_g, regs_c) -> list[str]:
             f"      err_q  <= req_valid & (sel_g_d == {{{ng}{{1'b0}}}}) & ~(chan_page_d & (|sel_c_d));",
             "      pend_q <= req_valid;", "    end", "  end", "",
             "  always @(posedge clk) begin", "    wdata_q <= req_wdata;", "    wstrb_q <= req_wstrb;", "  end", "",
-            "  wire [31:0] bmask = {{8{wstrb_q[3]}}, {8{wstrb_q[2]}}, {8{wstrb_q[1]}}, {8{wstrb_q[0]}}};", ""]
+            "  wire [31:0] bmask = {{8{wstrb_q[3]}}, {8{wstrb_q[2]}}, {8{wstrb_q[1]}}, {8{wstrb_q[0]}}};", "",
+            "  // The page gate of channel k's selects. With one channel, rd_c_q / wr_c_q are set only for",
+            "  // requests to its page, so it needs no gate (and page_q is left unused).",
+            "  wire [CHANNELS-1:0] page_hit = (CHANNELS == 1) ? {CHANNELS{1'b1}} : page_q;", ""]
     return out
