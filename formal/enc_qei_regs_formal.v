@@ -252,7 +252,8 @@ module enc_qei_regs_formal #(
       f_stage <= 32'd0;
     end else begin
       if (f_lo_hit && !f1_write) f_latch <= f_count[63:32];
-      if (f_hi_hit && f1_write) f_stage <= (f_stage & ~f_m_hi) | (f1_wdata & f_m_hi);
+      // an enabled lane takes the written byte (bits above COUNT_W are 0: they hold nothing)
+      if (f_hi_hit && f1_write) f_stage <= (f_stage & ~f_bmask) | (f1_wdata & f_m_hi);
     end
   end
 

@@ -165,7 +165,8 @@ module enc_qei_regs #(
     if (rst) begin
       tb_prescale_prescale_q <= 16'h0;
     end else if (wr_g_q[3]) begin
-      tb_prescale_prescale_q <= (tb_prescale_prescale_q & ~(bmask[15:0])) | (wdata_q[15:0] & bmask[15:0]);
+      if (wstrb_q[0]) tb_prescale_prescale_q[7:0] <= wdata_q[7:0];
+      if (wstrb_q[1]) tb_prescale_prescale_q[15:8] <= wdata_q[15:8];
     end
   end
   assign reg2hw_g[15:0] = ((TIMING != 0) ? tb_prescale_prescale_q : 16'd0);
@@ -183,7 +184,7 @@ module enc_qei_regs #(
     if (rst) begin
       gsnap_ctrl_in_en_q <= 1'h0;
     end else if (wr_g_q[4]) begin
-      gsnap_ctrl_in_en_q <= (gsnap_ctrl_in_en_q & ~(bmask[1:1])) | (wdata_q[1:1] & bmask[1:1]);
+      if (wstrb_q[0]) gsnap_ctrl_in_en_q <= wdata_q[1:1];
     end
   end
   assign reg2hw_g[17] = ((TIMING != 0) ? gsnap_ctrl_in_en_q : 1'd0);
@@ -193,7 +194,7 @@ module enc_qei_regs #(
     if (rst) begin
       gsnap_ctrl_period_en_q <= 1'h0;
     end else if (wr_g_q[4]) begin
-      gsnap_ctrl_period_en_q <= (gsnap_ctrl_period_en_q & ~(bmask[2:2])) | (wdata_q[2:2] & bmask[2:2]);
+      if (wstrb_q[0]) gsnap_ctrl_period_en_q <= wdata_q[2:2];
     end
   end
   assign reg2hw_g[18] = ((TIMING != 0) ? gsnap_ctrl_period_en_q : 1'd0);
@@ -203,7 +204,10 @@ module enc_qei_regs #(
     if (rst) begin
       gsnap_period_value_q <= 32'h0 & SZ_TS[31:0];
     end else if (wr_g_q[5]) begin
-      gsnap_period_value_q <= (gsnap_period_value_q & ~(bmask[31:0] & SZ_TS[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_TS[31:0]);
+      if (wstrb_q[0]) gsnap_period_value_q[7:0] <= wdata_q[7:0] & SZ_TS[7:0];
+      if (wstrb_q[1]) gsnap_period_value_q[15:8] <= wdata_q[15:8] & SZ_TS[15:8];
+      if (wstrb_q[2]) gsnap_period_value_q[23:16] <= wdata_q[23:16] & SZ_TS[23:16];
+      if (wstrb_q[3]) gsnap_period_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
     end
   end
   assign reg2hw_g[50:19] = ((TIMING != 0) ? gsnap_period_value_q : 32'd0);
@@ -236,7 +240,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_en_q <= 1'h1;
         end else if (wr_c[0]) begin
-          ctrl_en_q <= (ctrl_en_q & ~(bmask[0:0])) | (wdata_q[0:0] & bmask[0:0]);
+          if (wstrb_q[0]) ctrl_en_q <= wdata_q[0:0];
         end
       end
       assign r2h[0] = ctrl_en_q;
@@ -246,7 +250,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_swap_ab_q <= 1'h0;
         end else if (wr_c[0]) begin
-          ctrl_swap_ab_q <= (ctrl_swap_ab_q & ~(bmask[1:1])) | (wdata_q[1:1] & bmask[1:1]);
+          if (wstrb_q[0]) ctrl_swap_ab_q <= wdata_q[1:1];
         end
       end
       assign r2h[1] = ctrl_swap_ab_q;
@@ -256,7 +260,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_inv_a_q <= 1'h0;
         end else if (wr_c[0]) begin
-          ctrl_inv_a_q <= (ctrl_inv_a_q & ~(bmask[2:2])) | (wdata_q[2:2] & bmask[2:2]);
+          if (wstrb_q[0]) ctrl_inv_a_q <= wdata_q[2:2];
         end
       end
       assign r2h[2] = ctrl_inv_a_q;
@@ -266,7 +270,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_inv_b_q <= 1'h0;
         end else if (wr_c[0]) begin
-          ctrl_inv_b_q <= (ctrl_inv_b_q & ~(bmask[3:3])) | (wdata_q[3:3] & bmask[3:3]);
+          if (wstrb_q[0]) ctrl_inv_b_q <= wdata_q[3:3];
         end
       end
       assign r2h[3] = ctrl_inv_b_q;
@@ -276,7 +280,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_inv_z_q <= 1'h0;
         end else if (wr_c[0]) begin
-          ctrl_inv_z_q <= (ctrl_inv_z_q & ~(bmask[4:4])) | (wdata_q[4:4] & bmask[4:4]);
+          if (wstrb_q[0]) ctrl_inv_z_q <= wdata_q[4:4];
         end
       end
       assign r2h[4] = ctrl_inv_z_q;
@@ -286,7 +290,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_func_q <= 4'h0;
         end else if (wr_c[0]) begin
-          ctrl_func_q <= (ctrl_func_q & ~(bmask[11:8])) | (wdata_q[11:8] & bmask[11:8]);
+          if (wstrb_q[1]) ctrl_func_q[3:0] <= wdata_q[11:8];
         end
       end
       assign r2h[8:5] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
@@ -296,7 +300,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_range_q <= 2'h0;
         end else if (wr_c[0]) begin
-          ctrl_range_q <= (ctrl_range_q & ~(bmask[13:12])) | (wdata_q[13:12] & bmask[13:12]);
+          if (wstrb_q[1]) ctrl_range_q[1:0] <= wdata_q[13:12];
         end
       end
       assign r2h[10:9] = ((RANGE != 0) ? ctrl_range_q : 2'd0);
@@ -306,7 +310,7 @@ module enc_qei_regs #(
         if (rst) begin
           ctrl_filter_len_q <= 5'h3;
         end else if (wr_c[0]) begin
-          ctrl_filter_len_q <= (ctrl_filter_len_q & ~(bmask[20:16])) | (wdata_q[20:16] & bmask[20:16]);
+          if (wstrb_q[2]) ctrl_filter_len_q[4:0] <= wdata_q[20:16];
         end
       end
       assign r2h[15:11] = ctrl_filter_len_q;
@@ -323,8 +327,12 @@ module enc_qei_regs #(
           count_hi_stage_q <= 32'd0;
         end else begin
           if (count_lo_rd) count_hi_latch_q <= h2r[71:40];
-          if (wr_c[3]) count_hi_stage_q <= (count_hi_stage_q & ~(bmask[31:0] & SZ_COUNT_HI[31:0])) |
-                                                  (wdata_q & bmask[31:0] & SZ_COUNT_HI[31:0]);
+          if (wr_c[3]) begin
+            if (wstrb_q[0]) count_hi_stage_q[7:0] <= wdata_q[7:0] & SZ_COUNT_HI[7:0];
+            if (wstrb_q[1]) count_hi_stage_q[15:8] <= wdata_q[15:8] & SZ_COUNT_HI[15:8];
+            if (wstrb_q[2]) count_hi_stage_q[23:16] <= wdata_q[23:16] & SZ_COUNT_HI[23:16];
+            if (wstrb_q[3]) count_hi_stage_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
+          end
         end
       end
 
@@ -333,7 +341,10 @@ module enc_qei_regs #(
         if (rst) begin
           preset_lo_value_q <= 32'h0 & SZ_COUNT_LO[31:0];
         end else if (wr_c[4]) begin
-          preset_lo_value_q <= (preset_lo_value_q & ~(bmask[31:0] & SZ_COUNT_LO[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_LO[31:0]);
+          if (wstrb_q[0]) preset_lo_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_LO[7:0];
+          if (wstrb_q[1]) preset_lo_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_LO[15:8];
+          if (wstrb_q[2]) preset_lo_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_LO[23:16];
+          if (wstrb_q[3]) preset_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
       assign r2h[112:81] = preset_lo_value_q;
@@ -343,7 +354,10 @@ module enc_qei_regs #(
         if (rst) begin
           preset_hi_value_q <= 32'h0 & SZ_COUNT_HI[31:0];
         end else if (wr_c[5]) begin
-          preset_hi_value_q <= (preset_hi_value_q & ~(bmask[31:0] & SZ_COUNT_HI[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_HI[31:0]);
+          if (wstrb_q[0]) preset_hi_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_HI[7:0];
+          if (wstrb_q[1]) preset_hi_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_HI[15:8];
+          if (wstrb_q[2]) preset_hi_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_HI[23:16];
+          if (wstrb_q[3]) preset_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
       assign r2h[144:113] = preset_hi_value_q;
@@ -353,7 +367,10 @@ module enc_qei_regs #(
         if (rst) begin
           ceiling_lo_value_q <= 32'hFFFFFFFF & SZ_COUNT_LO[31:0];
         end else if (wr_c[6]) begin
-          ceiling_lo_value_q <= (ceiling_lo_value_q & ~(bmask[31:0] & SZ_COUNT_LO[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_LO[31:0]);
+          if (wstrb_q[0]) ceiling_lo_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_LO[7:0];
+          if (wstrb_q[1]) ceiling_lo_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_LO[15:8];
+          if (wstrb_q[2]) ceiling_lo_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_LO[23:16];
+          if (wstrb_q[3]) ceiling_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
       assign r2h[176:145] = ((RANGE != 0) ? ceiling_lo_value_q : 32'd0);
@@ -363,7 +380,10 @@ module enc_qei_regs #(
         if (rst) begin
           ceiling_hi_value_q <= 32'hFFFFFFFF & SZ_COUNT_HI[31:0];
         end else if (wr_c[7]) begin
-          ceiling_hi_value_q <= (ceiling_hi_value_q & ~(bmask[31:0] & SZ_COUNT_HI[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_HI[31:0]);
+          if (wstrb_q[0]) ceiling_hi_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_HI[7:0];
+          if (wstrb_q[1]) ceiling_hi_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_HI[15:8];
+          if (wstrb_q[2]) ceiling_hi_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_HI[23:16];
+          if (wstrb_q[3]) ceiling_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
       assign r2h[208:177] = ((RANGE != 0) ? ceiling_hi_value_q : 32'd0);
@@ -373,7 +393,10 @@ module enc_qei_regs #(
         if (rst) begin
           compare_lo_value_q <= 32'h0 & SZ_COUNT_LO[31:0];
         end else if (wr_c[8]) begin
-          compare_lo_value_q <= (compare_lo_value_q & ~(bmask[31:0] & SZ_COUNT_LO[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_LO[31:0]);
+          if (wstrb_q[0]) compare_lo_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_LO[7:0];
+          if (wstrb_q[1]) compare_lo_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_LO[15:8];
+          if (wstrb_q[2]) compare_lo_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_LO[23:16];
+          if (wstrb_q[3]) compare_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
       assign r2h[240:209] = ((RANGE != 0) ? compare_lo_value_q : 32'd0);
@@ -383,7 +406,10 @@ module enc_qei_regs #(
         if (rst) begin
           compare_hi_value_q <= 32'h0 & SZ_COUNT_HI[31:0];
         end else if (wr_c[9]) begin
-          compare_hi_value_q <= (compare_hi_value_q & ~(bmask[31:0] & SZ_COUNT_HI[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_COUNT_HI[31:0]);
+          if (wstrb_q[0]) compare_hi_value_q[7:0] <= wdata_q[7:0] & SZ_COUNT_HI[7:0];
+          if (wstrb_q[1]) compare_hi_value_q[15:8] <= wdata_q[15:8] & SZ_COUNT_HI[15:8];
+          if (wstrb_q[2]) compare_hi_value_q[23:16] <= wdata_q[23:16] & SZ_COUNT_HI[23:16];
+          if (wstrb_q[3]) compare_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
       assign r2h[272:241] = ((RANGE != 0) ? compare_hi_value_q : 32'd0);
@@ -393,7 +419,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_action_q <= 2'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_action_q <= (index_ctrl_action_q & ~(bmask[1:0])) | (wdata_q[1:0] & bmask[1:0]);
+          if (wstrb_q[0]) index_ctrl_action_q[1:0] <= wdata_q[1:0];
         end
       end
       assign r2h[274:273] = index_ctrl_action_q;
@@ -403,7 +429,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_oneshot_q <= 1'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_oneshot_q <= (index_ctrl_oneshot_q & ~(bmask[2:2])) | (wdata_q[2:2] & bmask[2:2]);
+          if (wstrb_q[0]) index_ctrl_oneshot_q <= wdata_q[2:2];
         end
       end
       assign r2h[275] = index_ctrl_oneshot_q;
@@ -413,7 +439,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_edge_q <= 1'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_edge_q <= (index_ctrl_edge_q & ~(bmask[3:3])) | (wdata_q[3:3] & bmask[3:3]);
+          if (wstrb_q[0]) index_ctrl_edge_q <= wdata_q[3:3];
         end
       end
       assign r2h[276] = index_ctrl_edge_q;
@@ -423,7 +449,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_gate_en_q <= 1'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_gate_en_q <= (index_ctrl_gate_en_q & ~(bmask[4:4])) | (wdata_q[4:4] & bmask[4:4]);
+          if (wstrb_q[0]) index_ctrl_gate_en_q <= wdata_q[4:4];
         end
       end
       assign r2h[277] = index_ctrl_gate_en_q;
@@ -433,7 +459,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_gate_a_q <= 1'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_gate_a_q <= (index_ctrl_gate_a_q & ~(bmask[5:5])) | (wdata_q[5:5] & bmask[5:5]);
+          if (wstrb_q[0]) index_ctrl_gate_a_q <= wdata_q[5:5];
         end
       end
       assign r2h[278] = index_ctrl_gate_a_q;
@@ -443,7 +469,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_gate_b_q <= 1'h0;
         end else if (wr_c[10]) begin
-          index_ctrl_gate_b_q <= (index_ctrl_gate_b_q & ~(bmask[6:6])) | (wdata_q[6:6] & bmask[6:6]);
+          if (wstrb_q[0]) index_ctrl_gate_b_q <= wdata_q[6:6];
         end
       end
       assign r2h[279] = index_ctrl_gate_b_q;
@@ -453,7 +479,7 @@ module enc_qei_regs #(
         if (rst) begin
           index_ctrl_arm_q <= 1'h1;
         end else if (wr_c[10] & (|(bmask[8:8]))) begin
-          index_ctrl_arm_q <= (index_ctrl_arm_q & ~(bmask[8:8])) | (wdata_q[8:8] & bmask[8:8]);
+          if (wstrb_q[1]) index_ctrl_arm_q <= wdata_q[8:8];
         end else if (h2r[72]) begin
           index_ctrl_arm_q <= 1'd0;
         end
@@ -465,7 +491,7 @@ module enc_qei_regs #(
         if (rst) begin
           probe_ctrl_en_q <= 1'h0;
         end else if (wr_c[13] & (|(bmask[0:0]))) begin
-          probe_ctrl_en_q <= (probe_ctrl_en_q & ~(bmask[0:0])) | (wdata_q[0:0] & bmask[0:0]);
+          if (wstrb_q[0]) probe_ctrl_en_q <= wdata_q[0:0];
         end else if (h2r[137]) begin
           probe_ctrl_en_q <= 1'd0;
         end
@@ -477,7 +503,7 @@ module enc_qei_regs #(
         if (rst) begin
           probe_ctrl_edge_q <= 1'h0;
         end else if (wr_c[13]) begin
-          probe_ctrl_edge_q <= (probe_ctrl_edge_q & ~(bmask[1:1])) | (wdata_q[1:1] & bmask[1:1]);
+          if (wstrb_q[0]) probe_ctrl_edge_q <= wdata_q[1:1];
         end
       end
       assign r2h[282] = ((PROBE != 0) ? probe_ctrl_edge_q : 1'd0);
@@ -487,7 +513,7 @@ module enc_qei_regs #(
         if (rst) begin
           probe_ctrl_once_q <= 1'h0;
         end else if (wr_c[13]) begin
-          probe_ctrl_once_q <= (probe_ctrl_once_q & ~(bmask[2:2])) | (wdata_q[2:2] & bmask[2:2]);
+          if (wstrb_q[0]) probe_ctrl_once_q <= wdata_q[2:2];
         end
       end
       assign r2h[283] = ((PROBE != 0) ? probe_ctrl_once_q : 1'd0);
@@ -617,7 +643,8 @@ module enc_qei_regs #(
         if (rst) begin
           irq_en_en_q <= 12'h0;
         end else if (wr_c[18]) begin
-          irq_en_en_q <= (irq_en_en_q & ~(bmask[11:0])) | (wdata_q[11:0] & bmask[11:0]);
+          if (wstrb_q[0]) irq_en_en_q[7:0] <= wdata_q[7:0];
+          if (wstrb_q[1]) irq_en_en_q[11:8] <= wdata_q[11:8];
         end
       end
       assign r2h[307:296] = irq_en_en_q;
@@ -657,7 +684,7 @@ module enc_qei_regs #(
         if (rst) begin
           snap_ctrl_in_en_q <= 1'h0;
         end else if (wr_c[21]) begin
-          snap_ctrl_in_en_q <= (snap_ctrl_in_en_q & ~(bmask[1:1])) | (wdata_q[1:1] & bmask[1:1]);
+          if (wstrb_q[0]) snap_ctrl_in_en_q <= wdata_q[1:1];
         end
       end
       assign r2h[309] = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
@@ -667,7 +694,7 @@ module enc_qei_regs #(
         if (rst) begin
           snap_ctrl_period_en_q <= 1'h0;
         end else if (wr_c[21]) begin
-          snap_ctrl_period_en_q <= (snap_ctrl_period_en_q & ~(bmask[2:2])) | (wdata_q[2:2] & bmask[2:2]);
+          if (wstrb_q[0]) snap_ctrl_period_en_q <= wdata_q[2:2];
         end
       end
       assign r2h[310] = ((PERIOD != 0) ? snap_ctrl_period_en_q : 1'd0);
@@ -677,7 +704,7 @@ module enc_qei_regs #(
         if (rst) begin
           snap_ctrl_edge_q <= 1'h0;
         end else if (wr_c[21]) begin
-          snap_ctrl_edge_q <= (snap_ctrl_edge_q & ~(bmask[3:3])) | (wdata_q[3:3] & bmask[3:3]);
+          if (wstrb_q[0]) snap_ctrl_edge_q <= wdata_q[3:3];
         end
       end
       assign r2h[311] = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
@@ -687,7 +714,10 @@ module enc_qei_regs #(
         if (rst) begin
           snap_period_value_q <= 32'h0 & SZ_TS[31:0];
         end else if (wr_c[22]) begin
-          snap_period_value_q <= (snap_period_value_q & ~(bmask[31:0] & SZ_TS[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_TS[31:0]);
+          if (wstrb_q[0]) snap_period_value_q[7:0] <= wdata_q[7:0] & SZ_TS[7:0];
+          if (wstrb_q[1]) snap_period_value_q[15:8] <= wdata_q[15:8] & SZ_TS[15:8];
+          if (wstrb_q[2]) snap_period_value_q[23:16] <= wdata_q[23:16] & SZ_TS[23:16];
+          if (wstrb_q[3]) snap_period_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
       assign r2h[343:312] = ((PERIOD != 0) ? snap_period_value_q : 32'd0);
@@ -697,7 +727,7 @@ module enc_qei_regs #(
         if (rst) begin
           period_ctrl_en_q <= 1'h0;
         end else if (wr_c[29]) begin
-          period_ctrl_en_q <= (period_ctrl_en_q & ~(bmask[0:0])) | (wdata_q[0:0] & bmask[0:0]);
+          if (wstrb_q[0]) period_ctrl_en_q <= wdata_q[0:0];
         end
       end
       assign r2h[344] = ((PERIOD != 0) ? period_ctrl_en_q : 1'd0);
@@ -707,7 +737,7 @@ module enc_qei_regs #(
         if (rst) begin
           period_ctrl_edge_q <= 1'h0;
         end else if (wr_c[29]) begin
-          period_ctrl_edge_q <= (period_ctrl_edge_q & ~(bmask[1:1])) | (wdata_q[1:1] & bmask[1:1]);
+          if (wstrb_q[0]) period_ctrl_edge_q <= wdata_q[1:1];
         end
       end
       assign r2h[345] = ((PERIOD != 0) ? period_ctrl_edge_q : 1'd0);
@@ -717,7 +747,7 @@ module enc_qei_regs #(
         if (rst) begin
           period_ctrl_n_q <= 8'h1;
         end else if (wr_c[29]) begin
-          period_ctrl_n_q <= (period_ctrl_n_q & ~(bmask[15:8])) | (wdata_q[15:8] & bmask[15:8]);
+          if (wstrb_q[1]) period_ctrl_n_q[7:0] <= wdata_q[15:8];
         end
       end
       assign r2h[353:346] = ((PERIOD != 0) ? period_ctrl_n_q : 8'd0);
@@ -727,7 +757,10 @@ module enc_qei_regs #(
         if (rst) begin
           stall_timeout_value_q <= 32'h0 & SZ_TS[31:0];
         end else if (wr_c[31]) begin
-          stall_timeout_value_q <= (stall_timeout_value_q & ~(bmask[31:0] & SZ_TS[31:0])) | (wdata_q[31:0] & bmask[31:0] & SZ_TS[31:0]);
+          if (wstrb_q[0]) stall_timeout_value_q[7:0] <= wdata_q[7:0] & SZ_TS[7:0];
+          if (wstrb_q[1]) stall_timeout_value_q[15:8] <= wdata_q[15:8] & SZ_TS[15:8];
+          if (wstrb_q[2]) stall_timeout_value_q[23:16] <= wdata_q[23:16] & SZ_TS[23:16];
+          if (wstrb_q[3]) stall_timeout_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
       assign r2h[385:354] = ((PERIOD != 0) ? stall_timeout_value_q : 32'd0);

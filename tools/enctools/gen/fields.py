@@ -107,7 +107,7 @@ class Fields:
                 val = f"(({fix} >= 0) ? {fix}[{w - 1}:0] : {q})" if fix else q
                 self.emit(f"  reg {self.rng(w)}{q};  // {rn}.{f.inst_name}", "  always @(posedge clk) begin",
                           "    if (rst) begin", f"      {q} <= {reset};")
-                self.emit(*self.update(kind, reg, f, q, w, sl, wmask, self.wr(k)))
+                self.emit(*self.update(kind, reg, f, q, w, sl, wmask, self.wr(k), sz))
                 self.emit("    end", "  end")
                 if kind != "counter":
                     self.emit(f"  assign {self.r2h(reg, f)} = {self.gate(feat, val, w)};")
@@ -118,16 +118,29 @@ class Fields:
                 reads.append(f"if ({feat} != 0) {line}" if feat else line)
         self.reads.append((rn, reads))
 
-    def update(self, kind, reg, f, q, w, sl, wmask, wr) -> list[str]:
+    @staticmethod
+    def lanes(q: str, lsb: int, msb: int, sz: str | None, src: str = "wdata_q",
+              indent: str = "      ") -> list[str]:
+        """A write of bits [msb:lsb] of ``src`` into ``q`` (bit 0 of q = bit lsb), one byte lane
+        at a time: each lane's bits are stored when its byte enable is set, so synthesis makes the
+        enable the flip-flops' clock enable (one LUT per lane, not a multiplexer per bit). Bits
+        outside ``sz`` (a width mask) are written 0, which they always hold."""
+        out = []
+        for b in range(lsb // 8, msb // 8 + 1):
+            lo, hi = max(lsb, 8 * b), min(msb, 8 * b + 7)
+            dst = f"{q}[{hi - lsb}:{lo - lsb}]" if msb > lsb else q
+            val = f"{src}[{hi}:{lo}]" + (f" & {sz}[{hi}:{lo}]" if sz else "")
+            out.append(f"{indent}if (wstrb_q[{b}]) {dst} <= {val};")
+        return out
+
+    def update(self, kind, reg, f, q, w, sl, wmask, wr, sz=None) -> list[str]:
         ename = f"{reg.inst_name}_{f.inst_name}".lower() if len(list(reg.fields())) > 1 \
             else reg.inst_name.lower()
         if kind == "cfg" and f.get_property("hwclr"):
-            return [f"    end else if ({wr} & (|({wmask}))) begin",
-                    f"      {q} <= ({q} & ~({wmask})) | (wdata_q{sl} & {wmask});",
-                    f"    end else if ({self.h2r(ename + '_clr')}) begin", f"      {q} <= {w}'d0;"]
+            return ([f"    end else if ({wr} & (|({wmask}))) begin"] + self.lanes(q, f.lsb, f.msb, sz)
+                    + [f"    end else if ({self.h2r(ename + '_clr')}) begin", f"      {q} <= {w}'d0;"])
         if kind == "cfg":
-            return [f"    end else if ({wr}) begin",
-                    f"      {q} <= ({q} & ~({wmask})) | (wdata_q{sl} & {wmask});"]
+            return [f"    end else if ({wr}) begin"] + self.lanes(q, f.lsb, f.msb, sz)
         if kind == "intr":
             sets = self.h2r(f"{reg.inst_name.lower()}_set", f.lsb, w)
             return ["    end else begin",
@@ -146,8 +159,10 @@ class Fields:
                       "  always @(posedge clk) begin", "    if (rst) begin",
                       "      count_hi_latch_q <= 32'd0;", "      count_hi_stage_q <= 32'd0;", "    end else begin",
                       f"      if (count_lo_rd) count_hi_latch_q <= {self.h2r('count', 32, 32)};",
-                      f"      if ({self.wr(k)}) count_hi_stage_q <= (count_hi_stage_q & ~({wmask})) |",
-                      f"                                              (wdata_q & {wmask});",
+                      f"      if ({self.wr(k)}) begin",
+                      *self.lanes("count_hi_stage_q", 0, 31, SIZE_MASKS.get(f.get_property("sized_by")),
+                                  indent="        "),
+                      "      end",
                       "    end", "  end", "")
             return "count_hi_latch_q"
         live = self.h2r("count", 0, 32)
