@@ -1,0 +1,77 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The modules `make mutate` mutates, and where their tests are.
+
+Each entry names the module's file and the test paths that cover it (pytest files, folders or
+ids, in priority order). The tests themselves, the builds, the parameter corners and the
+grouping of tests into simulations are discovered (enctools.mutation.discover). ``corners``
+picks which builds give corners (patterns on pytest ids, `*` the only wildcard; default: every build of the
+module's tests); every test that builds the module at a picked corner's values runs against its
+mutants, also those of builds that were not picked. ``priority`` only orders: those tests run
+first on the first mutants of a corner (after that, the tests that have killed go first).
+"""
+
+from __future__ import annotations
+
+from .data import Module, Suite
+
+# The enc_qei feature files share one environment (enctools.qei.env): one build per
+# configuration, so each configuration's tests run in one simulation per mutant set. Their suites
+# are long (40 to 70 s unmutated): a test runs on the unmutated design only once it has killed,
+# the limit is fixed (1.5 ms of simulated time: the longest tests, period_capture and the
+# count-rate bench's exact_at_bound, take 0.7 ms), and a mutant alive after a third of the first
+# group's tests is checked for equivalence at once.
+QEI_SUITE = Suite(lazy=True, limit_ns=1_500_000, cap=0.35)
+QEI_TESTS = ("tb/enc_qei", "tb/count_rate/test_count_rate_qei.py")
+WB1 = "tb/enc_qei/*[enc_qei_wb-c32-t32]"  # one channel, full profile, COUNT_W 32 / TS_W 32
+AX1 = "tb/enc_qei/*[enc_qei_axil-c64-t16]"  # one channel, full profile, COUNT_W 64 / TS_W 16
+WB3 = "tb/enc_qei/test_channels.py::*[enc_qei_wb-ch3-full]"  # three full channels
+AX4 = "tb/enc_qei/test_channels.py::*[enc_qei_axil-ch4-lean]"  # four lean channels
+QEI_FIRST = ("register_walk", "register_patterns", "events_and_irq", "reset_mid_motion")
+
+
+def qei(file: str, corners: tuple[str, ...], *first: str) -> Module:
+    return Module(file, QEI_TESTS, corners, suite=QEI_SUITE, priority=QEI_FIRST + first)
+
+
+RATE = "tb/count_rate/test_count_rate.py"
+
+MODULES: dict[str, Module] = {
+    "ls168": Module("rtl/ls168.v", ("tb/ls168/test_ls168.py",)),
+    # corners: the conditioner's own test (FILTER_LEN 1, 2, 3, 8); the count-rate bench runs
+    # at 1, 2, 3 too (its FILTER_LEN 4 build is not a corner of its own)
+    "enc_conditioner": Module("rtl/enc_conditioner.v", ("tb/enc_conditioner", RATE),
+                              ("tb/enc_conditioner/*",)),
+    "enc_x4_decoder": Module("rtl/enc_x4_decoder.v", ("tb/enc_x4_decoder", RATE)),
+    "enc_x2_xor": Module("rtl/enc_x2_xor.v", ("tb/enc_x2_xor", RATE)),
+    "enc_x1_hysteresis": Module("rtl/enc_x1_hysteresis.v", ("tb/enc_x1_hysteresis", RATE)),
+    "enc_updown_buffer": Module("rtl/enc_updown_buffer.v", ("tb/enc_updown_buffer",)),
+    # the behaviour tests at WINDOW_LOG2 13 only: the runs at 16 and 17 are accuracy runs
+    # (+-64 LSB) that by design cannot see a wrong LSB or a broken reset (doc/mutation.md)
+    "enc_phase_meter": Module("rtl/enc_phase_meter.v",
+                              ("tb/enc_phase_meter/test_enc_phase_meter.py::test_enc_phase_meter",)),
+    "enc_characterizer": Module("rtl/enc_characterizer.v", ("tb/enc_characterizer",)),
+    # enc_qei's parts. The conditioner has one parameter set in every build (MAX_FILTER_LEN 16).
+    "enc_conditioner_rt": qei("rtl/enc_conditioner_rt.v", (WB1,), "filter_lengths",
+                              "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset",
+                              "reset_in_each_state"),
+    "enc_qei_core": qei("rtl/enc_qei_core.v", (WB1, AX1, AX4), "swap_and_invert", "latches_wide",
+                        "coherent_64bit", "compare", "func_walks", "range_modes", "ceiling_wide",
+                        "bounded_range_fast", "steps_in_consecutive_clocks", "index_at_steps"),
+    "enc_qei_timing": qei("rtl/enc_qei_timing.v", (WB1, AX1), "snapshot_deltas_across_wraps",
+                          "snapshot_deltas_held", "stall_timeout_exact", "period_large_n",
+                          "snapshot_wide_values", "period_capture"),
+    "enc_qei_regs": qei("rtl/enc_qei_regs.v", (WB1, AX1, WB3), "byte_enables", "byte_enables_all",
+                        "unmapped_offsets", "irq_low_in_reset", "isolation", "channel_map"),
+    "enc_qei": qei("rtl/enc_qei.v", (WB1, AX1, WB3, AX4), "irq_low_in_reset", "irq_summary",
+                   "global_snapshot", "snapshot_wide_values"),
+    "enc_qei_channel": qei("rtl/enc_qei_channel.v", (WB1, AX1, AX4), "swap_and_invert",
+                           "filter_lengths", "snapshot_wide_values", "independent_walks"),
+    "enc_qei_timebase": qei("rtl/enc_qei_timebase.v", (WB1, AX1), "prescaler_and_snap_in",
+                            "prescaler_long", "unit_timer_prescaled"),
+    "enc_qei_snaptrig": qei("rtl/enc_qei_snaptrig.v", (WB1, AX1), "prescaler_and_snap_in",
+                            "unit_timer_period", "unit_timer_prescaled"),
+    "enc_qei_wb": qei("rtl/enc_qei_wb.v", (WB1, WB3), "wb_abandoned_cycle", "wb_abandoned_request",
+                      "byte_enables"),
+    "enc_qei_axil": qei("rtl/enc_qei_axil.v", (AX1, AX4), "concurrent_reads_and_writes",
+                        "byte_enables"),
+}
