@@ -355,6 +355,37 @@ async def ctrl_change_is_not_an_index_edge(dut):
     await bus.wr("INDEX_CTRL", 0)
 
 
+@cocotb_test()
+async def index_preset_at_wraps(dut):
+    """An index preset in the very clock of a step at a bound (up from CEILING, down from 0: a
+    wrap in modulo, a blocked step in limit and non_recycle), then a step in the next clock, in
+    every bounded range: the load wins, and the next step starts from the preset value (the
+    at-zero and at-CEILING flags computed for that clock are the preset's, not the wrap's)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for mode in ("modulo", "limit", "non_recycle"):
+        for ceiling in (0x25, 0x0800_0040):
+            await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
+            await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+            model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+            model.idx_gate, model.idx_arm = None, True
+            for preset in near([0, 1, ceiling // 2, ceiling - 1, ceiling], 0, model.max):
+                await bus.set64("PRESET", preset)
+                model.preset = preset
+                for before, steps in ((ceiling, (+1, -1, 0)), (ceiling, (+1, +1, 0)),
+                                      (0, (-1, +1, 0)), (0, (-1, -1, 0))):
+                    await bus.set_count(before)
+                    model.write_count(before)
+                    await env.settle(4)
+                    await play_clocks(env, model, step_clocks(env.pos, steps, (1, 0, 0)))
+                    await env.settle(4)
+                    await env.check(model, f"{mode} CEILING {ceiling:#x}: PRESET {preset:#x} in "
+                                    f"the clock of a step from {before:#x}, steps {steps}")
+            await bus.wr("INDEX_CTRL", 0)
+            model.idx_action = "none"
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_index_probe(top, count_w, ts_w):
