@@ -212,7 +212,7 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0) -> Res
                 if pairs[i] is None:
                     continue
                 t1, t2 = pairs[i]
-                a_max = float(np.max(np.abs(ch.acc[t1:t + 1]))) * clk * clk / 2 ** motion.FRAC
+                a_max = float(np.max(np.abs(ch.acc[t1:t + 1]))) * clk * clk / 2 ** motion.VFRAC
                 bound = (abs(v_read) / (t2 - t1 - 1) + a_max * (t - (t1 + t2) / 2 + 1) / clk
                          + 0.0005)
                 err = abs(v_read - v_true)

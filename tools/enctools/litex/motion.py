@@ -2,10 +2,11 @@
 """A deterministic motion per encoder channel, in Migen for the simulated SoC and in numpy for the
 test that checks what the firmware printed.
 
-Each channel is a fixed-point integrator clocked by sys: ``acc`` (count steps per clock², FRAC
+Each channel is a fixed-point integrator clocked by sys: ``acc`` (count steps per clock², VFRAC
 fraction bits) is a piecewise-constant function of the clock number ``t`` (0 at the first clock
-after reset), and in every clock ``vel += acc`` and ``pos += vel``. The shaft position in count
-steps is ``x = pos >> FRAC`` (floor); the encoder outputs are the quadrature state of ``x``
+after reset), and in every clock ``vel += acc`` and ``pos += vel >> (VFRAC - FRAC)`` (the step
+of the clock, FRAC fraction bits, rounded down). The shaft position in count steps is
+``x = pos >> FRAC`` (floor); the encoder outputs are the quadrature state of ``x``
 (forward = A leads B: x mod 4 = 0, 1, 2, 3 gives (A, B) = 00, 10, 11, 01) and an index ``z`` that
 is high while ``x mod CPR == 0`` (one state per CPR steps). A one-clock ``acc`` of v gives a
 velocity step to v. The Python model does the same integer arithmetic, so the position and the
@@ -18,16 +19,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-FRAC = 32          # fraction bits of pos, vel and acc
+FRAC = 32          # fraction bits of pos and of its step per clock
+VFRAC = 48         # fraction bits of vel and acc
 POS_W = 64         # pos register bits (signed): 32 integer bits
-VEL_W = 48
+VEL_W = 64
 CPR_LOG2 = 10      # index every 1024 count steps (256 cycles of x4)
 
 
 @dataclass
 class Motion:
     """One channel: ``x0`` the position at reset (count steps), ``steps`` the (clock, acc) pairs
-    (acc in 2^-FRAC count steps per clock², in force from that clock on; 0 before the first)."""
+    (acc in 2^-VFRAC count steps per clock², in force from that clock on; 0 before the first)."""
 
     name: str
     x0: int = 0
@@ -42,15 +44,17 @@ class Motion:
         return acc
 
     def trace(self, n: int) -> tuple[np.ndarray, np.ndarray]:
-        """(pos, vel) in clocks 0 .. n-1 (fixed point): vel[t+1] = vel[t] + acc[t],
-        pos[t+1] = pos[t] + vel[t]."""
+        """(pos, step) in clocks 0 .. n-1, FRAC fraction bits: vel[t+1] = vel[t] + acc[t],
+        step[t] = vel[t] >> (VFRAC - FRAC), pos[t+1] = pos[t] + step[t]. The step is the speed in
+        count steps per clock."""
         acc = self.acc_at(n)
         vel = np.zeros(n, dtype=np.int64)
         vel[1:] = np.cumsum(acc[:-1])
+        step = vel >> (VFRAC - FRAC)
         pos = np.empty(n, dtype=np.int64)
         pos[0] = self.x0 << FRAC
-        pos[1:] = pos[0] + np.cumsum(vel[:-1])
-        return pos, vel
+        pos[1:] = pos[0] + np.cumsum(step[:-1])
+        return pos, step
 
 
 def profiles(f_clk: float, t0_ms: float = 4.0) -> list[Motion]:
@@ -66,7 +70,7 @@ def profiles(f_clk: float, t0_ms: float = 4.0) -> list[Motion]:
         return int(round(ms * 1e-3 * f_clk))
 
     def v(counts_per_s):          # a velocity as fixed point counts per clock
-        return int(round(counts_per_s / f_clk * (1 << FRAC)))
+        return int(round(counts_per_s / f_clk * (1 << VFRAC)))
 
     def a(counts_per_s, ms):      # the acc that changes the speed by counts_per_s in ms
         return int(round(v(counts_per_s) / clk(ms)))
@@ -112,13 +116,15 @@ class MotionGen:
         for k, mo in enumerate(motions):
             acc = Signal((VEL_W, True))
             vel = Signal((VEL_W, True))
+            step = Signal((VEL_W - (VFRAC - FRAC), True))
             pos = Signal((POS_W, True), reset=mo.x0 << FRAC)
             # acc as a function of t: the last step whose clock has come
             expr = acc.eq(0)
             for clock, value in mo.steps:
                 expr = If(t >= clock, acc.eq(value)).Else(expr)
             m.comb += expr
-            m.sync += [vel.eq(vel + acc), pos.eq(pos + vel)]
+            m.comb += step.eq(vel[VFRAC - FRAC:])   # the top bits, as a signed number
+            m.sync += [vel.eq(vel + acc), pos.eq(pos + step)]
             x = pos[FRAC:]
             m.comb += [
                 m.a[k].eq(x[0] ^ x[1]),
