@@ -14,6 +14,7 @@ SEED       ?=
 RPM        ?=
 TEMP_C     ?=
 CLK_HZ     ?=
+BOARD      ?=
 
 # scripts/bin holds our Verilator shim; it must come before any system verilator.
 export PATH := $(CURDIR)/scripts/bin:$(CURDIR)/$(VENV)/bin:$(PATH)
@@ -27,7 +28,7 @@ SIM_OR_AUTO = $(if $(filter command line,$(origin SIM)),$(SIM),auto)
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc soc-sim
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc soc-sim soc-bitstream
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -83,6 +84,10 @@ velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 u
 soc-sim: $(SOC_STAMP) ## LiteX SoC (VexRiscv + enc_qei, Verilator) running sw/soc firmware, checked against the motion; doc/results/soc_sim.md
 	$(PY) scripts/soc_sim.py
 	ENC_SOC_SIM=1 $(PY) -m pytest -q tb/soc
+
+soc-bitstream: $(SOC_STAMP) ## the LiteX SoC with enc_qei on a board through Yosys/nextpnr (BOARD=icebreaker|colorlight_i5); doc/results/soc_bitstream.md
+	@case "$(BOARD)" in icebreaker|colorlight_i5) ;; *) echo "make soc-bitstream: give BOARD=icebreaker or BOARD=colorlight_i5" >&2; exit 2;; esac
+	$(PY) scripts/soc_bitstream.py --board $(BOARD)
 
 package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
 	@bash scripts/check_package.sh

@@ -130,7 +130,7 @@ def gateware_key(cfg: SocConfig) -> str:
 
 
 @contextlib.contextmanager
-def _output_to(fh):
+def output_to(fh):
     """Send this process's stdout and stderr (file descriptors 1 and 2, so also the output of its
     child processes) to the open file ``fh``."""
     sys.stdout.flush()
@@ -177,7 +177,7 @@ def build_gateware(cfg: SocConfig, force: bool = False) -> float:
     cfg.out.mkdir(parents=True, exist_ok=True)
     log = cfg.out / "build.log"
     _log(f"building the SoC {cfg.tag} (LiteX: Verilog, libraries) in {cfg.out.relative_to(TOP)}")
-    with open(log, "w") as fh, _output_to(fh):   # LiteX's messages and its make runs
+    with open(log, "w") as fh, output_to(fh):   # LiteX's messages and its make runs
         soc = make_soc(cfg)
         builder = Builder(soc, output_dir=str(cfg.out), compile_gateware=False)
         keep = ("libc", "libcompiler_rt", "libbase")
