@@ -5,6 +5,7 @@
 SHELL      := /bin/bash
 VENV       := .venv
 STAMP      := $(VENV)/.requirements-installed
+SOC_STAMP  := $(VENV)/.soc-installed
 PY         := $(VENV)/bin/python
 SIM        ?= icarus
 JOBS       ?= 2
@@ -13,6 +14,7 @@ SEED       ?=
 RPM        ?=
 TEMP_C     ?=
 CLK_HZ     ?=
+BOARD      ?=
 
 # scripts/bin holds our Verilator shim; it must come before any system verilator.
 export PATH := $(CURDIR)/scripts/bin:$(CURDIR)/$(VENV)/bin:$(PATH)
@@ -26,7 +28,7 @@ SIM_OR_AUTO = $(if $(filter command line,$(origin SIM)),$(SIM),auto)
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc soc-sim soc-bitstream
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -38,6 +40,9 @@ $(STAMP): requirements.txt scripts/bootstrap.sh
 	@bash scripts/bootstrap.sh
 
 venv: $(STAMP) ## create .venv from requirements.txt (done automatically by every target)
+
+$(SOC_STAMP): $(STAMP) requirements-soc.txt scripts/bootstrap.sh
+	@bash scripts/bootstrap.sh --soc
 
 demo: $(STAMP) ## the main job: a modeled HEDS-5000 drives every circuit (RPM= TEMP_C= CLK_HZ= SEED=)
 	@$(PY) scripts/demo.py --rpm "$(RPM)" --temp-c "$(TEMP_C)" --clk-hz "$(CLK_HZ)" --seed "$(SEED)" --sim $(SIM_OR_AUTO)
@@ -75,6 +80,14 @@ regs: $(STAMP) ## regenerate the enc_qei C header and register reference from rt
 
 velocity: $(STAMP) ## velocity-method accuracy benchmark on modelled HEDS-5000 units through enc_qei
 	$(PY) scripts/velocity_bench.py --jobs $(JOBS) --sim $(SIM_OR_AUTO)
+
+soc-sim: $(SOC_STAMP) ## LiteX SoC (VexRiscv + enc_qei, Verilator) running sw/soc firmware, checked against the motion; doc/results/soc_sim.md
+	$(PY) scripts/soc_sim.py
+	ENC_SOC_SIM=1 $(PY) -m pytest -q tb/soc
+
+soc-bitstream: $(SOC_STAMP) ## the LiteX SoC with enc_qei on a board through Yosys/nextpnr (BOARD=icebreaker|colorlight_i5); doc/results/soc_bitstream.md
+	@case "$(BOARD)" in icebreaker|colorlight_i5) ;; *) echo "make soc-bitstream: give BOARD=icebreaker or BOARD=colorlight_i5" >&2; exit 2;; esac
+	$(PY) scripts/soc_bitstream.py --board $(BOARD)
 
 package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
 	@bash scripts/check_package.sh

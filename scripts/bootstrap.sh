@@ -4,8 +4,35 @@
 # (Icarus Verilog, a C++ compiler and make for Verilator's model build) are present.
 # Missing system tools are installed with apt-get when running as root; otherwise a one-line
 # message names the package to install. Called by the Makefile; safe to run again.
+# `bootstrap.sh --soc` (the soc targets, after the above) adds the LiteX SoC simulation: the RISC-V
+# cross compiler and the libraries of LiteX's simulator from Debian, requirements-soc.txt into .venv.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+if [ "${1:-}" = "--soc" ]; then
+  soc_pkgs=()
+  command -v riscv64-unknown-elf-gcc >/dev/null 2>&1 || soc_pkgs+=(gcc-riscv64-unknown-elf)
+  [ -e /usr/include/event2/event.h ] || soc_pkgs+=(libevent-dev)
+  [ -e /usr/include/json-c/json.h ] || soc_pkgs+=(libjson-c-dev)
+  [ -e /usr/include/zlib.h ] || soc_pkgs+=(zlib1g-dev)
+  if [ ${#soc_pkgs[@]} -gt 0 ]; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+      echo "bootstrap: installing ${soc_pkgs[*]} with apt-get (LiteX SoC simulation)"
+      apt=(apt-get -o APT::Sandbox::User=root)
+      if ! { "${apt[@]}" update -qq && DEBIAN_FRONTEND=noninteractive "${apt[@]}" install -y -qq "${soc_pkgs[@]}"; } >/tmp/bootstrap-apt-soc.log 2>&1; then
+        echo "bootstrap: apt-get could not install ${soc_pkgs[*]} (see /tmp/bootstrap-apt-soc.log); install them and run again" >&2
+        exit 1
+      fi
+    else
+      echo "bootstrap: missing system packages for the SoC simulation: ${soc_pkgs[*]} (install them, e.g. 'sudo apt-get install ${soc_pkgs[*]}')" >&2
+      exit 1
+    fi
+  fi
+  echo "bootstrap: installing requirements-soc.txt into .venv"
+  .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements-soc.txt
+  touch .venv/.soc-installed
+  exit 0
+fi
 
 need_pkgs=()
 command -v iverilog >/dev/null 2>&1 || need_pkgs+=(iverilog)

@@ -1,0 +1,147 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei in a LiteX SoC.
+
+``EncQEI`` wraps the Verilog peripheral ``enc_qei_wb`` as a LiteX module: a 32-bit Wishbone slave
+(LiteX's word address turned into the peripheral's byte address), the encoder inputs, ``snap_in``,
+``cmp_out`` and the interrupt through a LiteX EventManager. The Verilog sources and include folders
+come from enc_ip.core (``enctools.core``). ``add_enc_qei`` maps one into a SoC::
+
+    from enctools.litex import add_enc_qei
+    pads = platform.request("encoders")   # subsignals a, b (and z, probe, snap, cmp), CHANNELS wide
+    add_enc_qei(soc, name="enc_qei", pads=pads, channels=4, profile="full")
+
+Firmware then finds ``ENC_QEI_BASE`` in generated/mem.h and ``ENC_QEI_INTERRUPT`` in
+generated/soc.h, enables the event with ``enc_qei_ev_enable_write(1)`` and uses
+sw/enc_qei_regs.h: doc/litex.md.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+
+from migen import Cat, ClockSignal, Constant, Instance, ResetSignal, Signal
+
+from litex.gen import LiteXModule
+from litex.soc.integration.soc import SoCRegion
+from litex.soc.interconnect import wishbone
+from litex.soc.interconnect.csr_eventmanager import EventManager, EventSourceLevel
+
+from .. import core
+from ..paths import TOP
+
+PROFILES = {"counting": 1, "full": 2, "lean": 3}   # CAPS.PROFILE values (rtl/enc_qei.rdl)
+
+
+def addr_width(channels: int) -> int:
+    """The least byte-address width that holds every page: 8 + ceil(log2(CHANNELS))."""
+    return 8 + max(0, (channels - 1).bit_length())
+
+
+@lru_cache(maxsize=None)
+def verilog_files(top: str = "enc_qei_wb") -> tuple[str, ...]:
+    """The files of enc_ip.core's rtl fileset that ``top`` needs: its own and those of every module
+    it instantiates, down the hierarchy (one module per file, named after it)."""
+    by_module = {f.rsplit("/", 1)[-1][:-2]: f for f in core.rtl_files()}
+    if top not in by_module:
+        raise KeyError(f"enc_ip.core: no module {top} in the rtl fileset")
+    need, todo = [], [top]
+    while todo:
+        mod = todo.pop()
+        if by_module[mod] in need:
+            continue
+        need.append(by_module[mod])
+        text = re.sub(r"//[^\n]*", "", (TOP / by_module[mod]).read_text())
+        for name in re.findall(r"^\s*(\w+)\s*(?:#\s*\(|\w+\s*\()", text, re.M):
+            if name in by_module and name != mod:
+                todo.append(name)
+    return tuple(sorted(need))
+
+
+def add_sources(platform, top: str = "enc_qei_wb") -> None:
+    """Add the Verilog of ``top`` and the IP's include folders to a LiteX platform."""
+    for f in verilog_files(top):
+        platform.add_source(str(TOP / f))
+    for d in core.include_dirs():
+        platform.add_verilog_include_path(str(d))
+
+
+class EncQEI(LiteXModule):
+    """``enc_qei_wb`` with CHANNELS encoder channels on a LiteX Wishbone bus.
+
+    Attributes: ``bus`` (wishbone.Interface, 32-bit data, word addressed, the SoC's side), the
+    inputs ``a``, ``b``, ``z``, ``probe`` (CHANNELS bits each, asynchronous), ``snap`` (one bit,
+    synchronous to sys), the output ``cmp`` (CHANNELS bits), ``irq`` (the peripheral's level
+    interrupt) and ``ev`` (an EventManager with the one level source ``qei``, whose ``irq`` a
+    LiteX SoC connects to its CPU). ``pads``, when given, is any object with attributes ``a`` and
+    ``b`` and optionally ``z``, ``probe``, ``snap`` and ``cmp``; absent inputs are tied to 0.
+    """
+
+    def __init__(self, platform, pads=None, channels: int = 1, profile: str = "full",
+                 count_w: int = 32, ts_w: int = 32, func_mask: int | None = None,
+                 addr_w: int | None = None):
+        for name, value in (("CHANNELS", channels), ("COUNT_W", count_w), ("TS_W", ts_w)):
+            if not core.param_range(name).ok(value):
+                raise ValueError(f"EncQEI: {name} = {value} is outside "
+                                 f"{core.param_range(name).text()} (enc_ip.core)")
+        if profile not in PROFILES:
+            raise ValueError(f"EncQEI: profile {profile!r} is not one of {', '.join(PROFILES)}")
+        self.channels = channels
+        self.profile = profile
+        self.count_w = count_w
+        self.ts_w = ts_w
+        self.addr_w = addr_w or addr_width(channels)
+        self.size = 1 << self.addr_w   # bytes of the bus window
+
+        self.bus = wishbone.Interface(data_width=32, address_width=32, addressing="word")
+        self.a = Signal(channels)
+        self.b = Signal(channels)
+        self.z = Signal(channels)
+        self.probe = Signal(channels)
+        self.snap = Signal()
+        self.cmp = Signal(channels)
+        self.irq = Signal()
+
+        self.ev = EventManager()
+        self.ev.qei = EventSourceLevel(description="enc_qei interrupt: read IRQ_SUMMARY")
+        self.ev.finalize()
+        self.comb += self.ev.qei.trigger.eq(self.irq)
+
+        if pads is not None:
+            for name in ("a", "b", "z", "probe", "snap"):
+                if hasattr(pads, name):
+                    self.comb += getattr(self, name).eq(getattr(pads, name))
+            if hasattr(pads, "cmp"):
+                self.comb += pads.cmp.eq(self.cmp)
+
+        params = dict(p_CHANNELS=channels, p_ADDR_W=self.addr_w, p_COUNT_W=count_w, p_TS_W=ts_w,
+                      p_PROFILE=PROFILES[profile])
+        if func_mask is not None:
+            params["p_FUNC_MASK"] = func_mask
+        # LiteX's Wishbone address counts 32-bit words; enc_qei_wb takes the byte address.
+        byte_adr = Cat(Constant(0, 2), self.bus.adr[:self.addr_w - 2])
+        self.specials += Instance(
+            "enc_qei_wb", **params,
+            i_clk=ClockSignal("sys"), i_rst=ResetSignal("sys"),
+            i_wb_adr_i=byte_adr, i_wb_dat_i=self.bus.dat_w, o_wb_dat_o=self.bus.dat_r,
+            i_wb_sel_i=self.bus.sel, i_wb_we_i=self.bus.we, i_wb_stb_i=self.bus.stb,
+            i_wb_cyc_i=self.bus.cyc, o_wb_ack_o=self.bus.ack, o_wb_err_o=self.bus.err,
+            i_a_in=self.a, i_b_in=self.b, i_z_in=self.z, i_probe_in=self.probe,
+            i_snap_in=self.snap, o_irq=self.irq, o_cmp_out=self.cmp,
+        )
+        add_sources(platform)
+
+
+def add_enc_qei(soc, name: str = "enc_qei", pads=None, channels: int = 1, profile: str = "full",
+                count_w: int = 32, ts_w: int = 32, origin: int | None = None, **kwargs) -> EncQEI:
+    """Instantiate an EncQEI in ``soc``: its registers in an uncached bus region of 2^ADDR_W bytes
+    (at ``origin``, or wherever the SoC allocates it), its event on the interrupt controller.
+    Returns the module."""
+    qei = EncQEI(soc.platform, pads=pads, channels=channels, profile=profile, count_w=count_w,
+                 ts_w=ts_w, **kwargs)
+    soc.add_module(name=name, module=qei)
+    soc.bus.add_slave(name=name, slave=qei.bus,
+                      region=SoCRegion(origin=origin, size=qei.size, cached=False))
+    if soc.irq.enabled:
+        soc.irq.add(name, use_loc_if_exists=True)
+    return qei
