@@ -178,6 +178,23 @@ async def free_range_ignores_ceiling(dut):
             await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
 
 
+@cocotb_test()
+async def single_bit_ceilings(dut):
+    """CEILING = 2^k and 2^k + 1 for every bit k above 0, in modulo and limit: steps in
+    consecutive clocks from 0 up and back down across 0 (the "CEILING <= 1" flag of the next
+    count's candidates must see every bit of CEILING)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    for mode in ("modulo", "limit"):
+        await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=0x25)
+        for k in range(1, env.count_w):
+            for ceiling in (1 << k, 1 << k | 1):
+                await env.bus.set64("CEILING", ceiling)
+                model.ceiling = ceiling
+                await steps_from(env, model, 0, (+1, +1, -1, -1, -1, 0, +1, 0))
+                await env.check(model, f"{mode} CEILING {ceiling:#x}, steps from 0")
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_ranges(top, count_w, ts_w):
