@@ -311,6 +311,69 @@ async def period_held_after_disable(dut):
                 await ClockCycles(dut.clk, gap)
 
 
+@cocotb_test()
+async def stall_timeout_high_bits(dut):
+    """STALL_TIMEOUT with bit 14 set (0x4005 ticks, PRESCALE 0): the stall comes exactly 0x4005 -
+    0x40 clocks later than at 0x40, counted from a step to irq (IRQ_EN = STALL)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    await bus.wr("IRQ_EN", event_bits("STALL"))
+    clocks = {}
+    for t in (0x40, 0x4005):
+        await bus.wr("STALL_TIMEOUT", t)
+        await Timer((t + 40) * PERIOD_PS, unit="ps")  # any stall of the wait is over
+        await RisingEdge(dut.clk)
+        await bus.events()
+        await env.settle(3)
+        assert dut.irq.value == 0
+        await FallingEdge(dut.clk)
+        env.pos += 1
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+        n = 0
+        while dut.irq.value == 0:
+            await RisingEdge(dut.clk)
+            n += 1
+            assert n < t + 200, f"STALL_TIMEOUT {t:#x}: no stall"
+        clocks[t] = n
+        await bus.events()
+    assert clocks[0x4005] - clocks[0x40] == 0x4005 - 0x40, \
+        f"{clocks[0x4005]} clocks to the stall at 0x4005, {clocks[0x40]} at 0x40"
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb_test()
+async def period_held_until_next_capture(dut):
+    """After PERIOD_CTRL.EN is cleared and set again, PERIOD keeps the last measurement (0x1A9
+    ticks: bits 0, 3, 5, 7, 8) through the first edge, which only starts a new measurement; the
+    next edge captures the new one."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    d = 0x1A9
+    ctrl = pack("PERIOD_CTRL", EN=1, EDGE="any", N=1)
+    await bus.wr("PERIOD_CTRL", ctrl)
+    await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+    assert await bus.rd("PERIOD") == d
+    await bus.wr("PERIOD_CTRL", 0)
+    await bus.wr("PERIOD_CTRL", ctrl)
+    # a start edge 0x40 clocks from now, the end edge e clocks after it; PERIOD read between them
+    e = 0x300
+    play = cocotb.start_soon(env.play(walk([1, 1], [0x40 * T_NS, e * T_NS], start_pos=env.pos), None))
+    await ClockCycles(dut.clk, 0x40 + 30)
+    for gap in (1, 2, 0):
+        period = await bus.rd("PERIOD")
+        assert period == d, f"PERIOD {period:#x} after a start edge, expected {d:#x} (held)"
+        if gap:
+            await ClockCycles(dut.clk, gap)
+    await play
+    period = await bus.rd("PERIOD")
+    assert period == e, f"PERIOD {period:#x} after the end edge, expected {e:#x}"
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_timing(top, count_w, ts_w):
