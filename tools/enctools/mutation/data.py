@@ -37,12 +37,14 @@ class Suite:
 @dataclass(frozen=True)
 class Module:
     """A module to mutate: its file, the tests that cover it (pytest paths or ids, in priority
-    order: survivors of one group go on to the next), and optionally which builds give its
-    corners (patterns on pytest ids, `*` the only wildcard; default: every build of its tests)."""
+    order: survivors of one group go on to the next; ``exclude`` leaves paths under them out),
+    and optionally which builds give its corners (patterns on pytest ids, `*` the only wildcard;
+    default: every build of its tests)."""
 
     file: str
     tests: tuple[str, ...]
     corners: tuple[str, ...] = ()
+    exclude: tuple[str, ...] = ()  # test paths or ids under ``tests`` that do not cover it
     n: int = 25
     suite: Suite = Suite()
     priority: tuple[str, ...] = ()  # cocotb test names to run first (order only)
@@ -93,7 +95,11 @@ class Corner:
 
     @property
     def label(self) -> str:
+        """The parameters that differ from the module's defaults (all of them when there are
+        only one or two), or "defaults"."""
         diff = {k: v for k, v in self.params.items() if self.defaults.get(k) != v}
+        if not diff and len(self.params) <= 2:
+            diff = self.params
         return " ".join(f"{k}={v}" for k, v in diff.items()) or "defaults"
 
     @property

@@ -66,11 +66,14 @@ def matches(pattern: str, nodeid: str) -> bool:
     return re.fullmatch(".*".join(map(re.escape, pattern.split("*"))), nodeid) is not None
 
 
-def groups_of(entries: list[dict], selectors: tuple[str, ...]) -> list[Group]:
-    """The groups of the pytest ids ``selectors`` pick, in selector order."""
+def groups_of(entries: list[dict], selectors: tuple[str, ...],
+              exclude: tuple[str, ...] = ()) -> list[Group]:
+    """The groups of the pytest ids ``selectors`` pick (less those ``exclude`` picks), in
+    selector order."""
     ordered: list[dict] = []
     for s in selectors:
-        ordered += [e for e in entries if selects(s, e["nodeid"]) and e not in ordered]
+        ordered += [e for e in entries if selects(s, e["nodeid"]) and e not in ordered
+                    and not any(selects(x, e["nodeid"]) for x in exclude)]
     groups: dict[str, Group] = {}
     for e in ordered:
         g = groups.get(e["key"])
@@ -89,7 +92,7 @@ def corners_of(root: Path, name: str, spec: Module, entries: list[dict], default
     """The corners of one module and notes on the builds left out."""
     notes = []
     found: list[dict] = []  # {"params", "groups", "picked"}, in the order of the test paths
-    for g in groups_of(entries, spec.tests):
+    for g in groups_of(entries, spec.tests, spec.exclude):
         sets = instances(g).get(name, [])
         if not sets:
             continue

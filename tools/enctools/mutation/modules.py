@@ -21,7 +21,9 @@ from .data import Module, Suite
 # count-rate bench's exact_at_bound, take 0.7 ms), and a mutant alive after a third of the first
 # group's tests is checked for equivalence at once.
 QEI_SUITE = Suite(lazy=True, limit_ns=1_500_000, cap=0.35)
-QEI_TESTS = ("tb/enc_qei", "tb/count_rate/test_count_rate_qei.py")
+FEATURES = "tb/enc_qei"
+CHANNELS = "tb/enc_qei/test_channels.py"  # several channels: for the modules that page them
+RATE_QEI = "tb/count_rate/test_count_rate_qei.py"  # COUNT and EVENTS at the count-rate bound
 WB1 = "tb/enc_qei/*[enc_qei_wb-c32-t32]"  # one channel, full profile, COUNT_W 32 / TS_W 32
 AX1 = "tb/enc_qei/*[enc_qei_axil-c64-t16]"  # one channel, full profile, COUNT_W 64 / TS_W 16
 WB3 = "tb/enc_qei/test_channels.py::*[enc_qei_wb-ch3-full]"  # three full channels
@@ -29,8 +31,11 @@ AX4 = "tb/enc_qei/test_channels.py::*[enc_qei_axil-ch4-lean]"  # four lean chann
 QEI_FIRST = ("register_walk", "register_patterns", "events_and_irq", "reset_mid_motion")
 
 
-def qei(file: str, corners: tuple[str, ...], *first: str) -> Module:
-    return Module(file, QEI_TESTS, corners, suite=QEI_SUITE, priority=QEI_FIRST + first)
+def qei(file: str, corners: tuple[str, ...], *first: str, rate: bool = False,
+        channels: bool = False) -> Module:
+    return Module(file, (FEATURES, RATE_QEI) if rate else (FEATURES,), corners,
+                  exclude=() if channels else (CHANNELS,), suite=QEI_SUITE,
+                  priority=QEI_FIRST + first)
 
 
 RATE = "tb/count_rate/test_count_rate.py"
@@ -53,25 +58,28 @@ MODULES: dict[str, Module] = {
     # enc_qei's parts. The conditioner has one parameter set in every build (MAX_FILTER_LEN 16).
     "enc_conditioner_rt": qei("rtl/enc_conditioner_rt.v", (WB1,), "filter_lengths",
                               "filter_len_clamp", "reset_on_rejection_clock", "step_soon_after_reset",
-                              "reset_in_each_state"),
-    "enc_qei_core": qei("rtl/enc_qei_core.v", (WB1, AX1, AX4), "swap_and_invert", "latches_wide",
+                              "reset_in_each_state", rate=True),
+    "enc_qei_core": qei("rtl/enc_qei_core.v", (WB1, AX1), "swap_and_invert", "latches_wide",
                         "coherent_64bit", "compare", "func_walks", "range_modes", "ceiling_wide",
-                        "bounded_range_fast", "steps_in_consecutive_clocks", "index_at_steps"),
+                        "bounded_range_fast", "steps_in_consecutive_clocks", "index_at_steps",
+                        rate=True),
     "enc_qei_timing": qei("rtl/enc_qei_timing.v", (WB1, AX1), "snapshot_deltas_across_wraps",
                           "snapshot_deltas_held", "stall_timeout_exact", "period_large_n",
                           "snapshot_wide_values", "period_capture"),
     "enc_qei_regs": qei("rtl/enc_qei_regs.v", (WB1, AX1, WB3), "byte_enables", "byte_enables_all",
-                        "unmapped_offsets", "irq_low_in_reset", "isolation", "channel_map"),
-    "enc_qei": qei("rtl/enc_qei.v", (WB1, AX1, WB3, AX4), "irq_low_in_reset", "irq_summary",
-                   "global_snapshot", "snapshot_wide_values"),
-    "enc_qei_channel": qei("rtl/enc_qei_channel.v", (WB1, AX1, AX4), "swap_and_invert",
-                           "filter_lengths", "snapshot_wide_values", "independent_walks"),
-    "enc_qei_timebase": qei("rtl/enc_qei_timebase.v", (WB1, AX1), "prescaler_and_snap_in",
+                        "unmapped_offsets", "irq_low_in_reset", "isolation", "channel_map",
+                        channels=True),
+    "enc_qei": qei("rtl/enc_qei.v", (AX1, WB3), "irq_low_in_reset", "irq_summary",
+                   "global_snapshot", "snapshot_wide_values", channels=True),
+    "enc_qei_channel": qei("rtl/enc_qei_channel.v", (WB1, AX4), "swap_and_invert",
+                           "filter_lengths", "snapshot_wide_values", "independent_walks",
+                           channels=True),
+    "enc_qei_timebase": qei("rtl/enc_qei_timebase.v", (AX1,), "prescaler_and_snap_in",
                             "prescaler_long", "unit_timer_prescaled"),
-    "enc_qei_snaptrig": qei("rtl/enc_qei_snaptrig.v", (WB1, AX1), "prescaler_and_snap_in",
+    "enc_qei_snaptrig": qei("rtl/enc_qei_snaptrig.v", (AX1,), "prescaler_and_snap_in",
                             "unit_timer_period", "unit_timer_prescaled"),
-    "enc_qei_wb": qei("rtl/enc_qei_wb.v", (WB1, WB3), "wb_abandoned_cycle", "wb_abandoned_request",
+    "enc_qei_wb": qei("rtl/enc_qei_wb.v", (WB1,), "wb_abandoned_cycle", "wb_abandoned_request",
                       "byte_enables"),
-    "enc_qei_axil": qei("rtl/enc_qei_axil.v", (AX1, AX4), "concurrent_reads_and_writes",
+    "enc_qei_axil": qei("rtl/enc_qei_axil.v", (AX1,), "concurrent_reads_and_writes",
                         "byte_enables"),
 }
