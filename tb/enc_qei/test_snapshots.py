@@ -299,6 +299,74 @@ async def snapshot_edge_delta_after_reversal(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
+@cocotb_test()
+async def global_snapshot_one_channel(dut):
+    """The global snapshot of a one-channel build: by GSNAP_CTRL.CMD (ten of them, at timebase
+    values 173 clocks and a bus transfer apart), by a rising snap_in with GSNAP_CTRL.IN_EN (none
+    without it; GSNAP_TIME between the TIMEBASE values read before and after) and by the global
+    unit timer (GSNAP_PERIOD 0x155: consecutive GSNAP_TIMEs exactly that far apart). Each one
+    latches the channel's snapshot in its own clock (SNAP_TIME = GSNAP_TIME) and raises
+    SNAP_READY."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ready = event_bits("SNAP_READY")
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    await env.setup(QeiModel(env.count_w), count=0)
+
+    async def taken(what: str) -> int:
+        gtime = await bus.rd("GSNAP_TIME")
+        own = await bus.rd("SNAP_TIME")
+        assert own == gtime, f"{what}: SNAP_TIME {own:#x}, GSNAP_TIME {gtime:#x}"
+        ev = await bus.rd("EVENTS")
+        assert ev & ready, f"{what}: no SNAP_READY (EVENTS {ev:#x})"
+        await bus.wr("EVENTS", ready)
+        return gtime
+
+    for i in range(10):
+        await ClockCycles(dut.clk, 173)
+        await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+        await env.settle(4)
+        await taken(f"CMD snapshot {i}")
+
+    async def pulse_snap_in() -> tuple[int, int]:
+        before = await bus.rd("TIMEBASE")
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 1
+        await ClockCycles(dut.clk, 3)
+        await FallingEdge(dut.clk)
+        dut.snap_in.value = 0
+        await env.settle(4)
+        return before, await bus.rd("TIMEBASE")
+
+    last = await bus.rd("GSNAP_TIME")
+    await pulse_snap_in()
+    assert await bus.rd("GSNAP_TIME") == last, "snap_in with IN_EN = 0 took a global snapshot"
+    assert not await bus.rd("EVENTS") & ready, "snap_in with IN_EN = 0 raised SNAP_READY"
+    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", IN_EN=1))
+    for i in range(4):
+        await ClockCycles(dut.clk, 150 + 61 * i)
+        before, after = await pulse_snap_in()
+        gtime = await taken(f"snap_in snapshot {i}")
+        assert (gtime - before) & ts_mask <= (after - before) & ts_mask, \
+            f"snap_in snapshot {i}: GSNAP_TIME {gtime:#x} outside {before:#x}..{after:#x}"
+    await bus.wr("GSNAP_CTRL", 0)
+
+    period = 0x155
+    await bus.wr("GSNAP_PERIOD", period)
+    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+    times = []
+    while len(times) < 4:
+        await ClockCycles(dut.clk, 40)
+        if not await bus.rd("EVENTS") & ready:
+            continue
+        gtime = await taken(f"timer snapshot {len(times)}")
+        assert await bus.rd("GSNAP_TIME") == gtime, "the unit timer fired again during the reads"
+        times.append(gtime)
+    await bus.wr("GSNAP_CTRL", 0)
+    gaps = [(b - a) & ts_mask for a, b in zip(times, times[1:])]
+    assert gaps == [period] * 3, f"GSNAP_TIMEs {[hex(t) for t in times]}: gaps {gaps}, GSNAP_PERIOD {period}"
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_snapshots(top, count_w, ts_w):

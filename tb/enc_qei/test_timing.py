@@ -374,6 +374,37 @@ async def period_held_until_next_capture(dut):
     period = await bus.rd("PERIOD")
     assert period == e, f"PERIOD {period:#x} after the end edge, expected {e:#x}"
 
+@cocotb_test()
+async def prescale_high_bits(dut):
+    """TB_PRESCALE with a high bit set (0x8003, 0x4005, 0x2007, 0x1009: more than 4,000 clocks per
+    tick): TIMEBASE advances at most once over 400 clocks. And a new PRESCALE restarts the
+    prescaler: from 0x3FF (a tick just taken) to 0, TIMEBASE advances every clock from a few
+    clocks after the write (not after the old count of up to 1,024 clocks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    for pre in (0x8003, 0x4005, 0x2007, 0x1009):
+        await bus.wr("TB_PRESCALE", pre)
+        await ClockCycles(dut.clk, 8)
+        t0 = await bus.rd("TIMEBASE")
+        await ClockCycles(dut.clk, 400)
+        t1 = await bus.rd("TIMEBASE")
+        assert (t1 - t0) & ts_mask <= 1, \
+            f"PRESCALE {pre:#x}: TIMEBASE {t0:#x} -> {t1:#x} in 400 clocks"
+    await bus.wr("TB_PRESCALE", 0x3FF)
+    t0 = await bus.rd("TIMEBASE")
+    while await bus.rd("TIMEBASE") == t0:  # a tick: the prescaler counts 0x3FF down again
+        await ClockCycles(dut.clk, 5)
+    await bus.wr("TB_PRESCALE", 0)
+    await ClockCycles(dut.clk, 8)
+    t0 = await bus.rd("TIMEBASE")
+    await ClockCycles(dut.clk, 100)
+    t1 = await bus.rd("TIMEBASE")
+    assert (t1 - t0) & ts_mask >= 100, \
+        f"PRESCALE 0x3ff -> 0: TIMEBASE {t0:#x} -> {t1:#x} in 100 clocks and a read"
+    await bus.wr("TB_PRESCALE", 0)
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_timing(top, count_w, ts_w):
