@@ -27,7 +27,6 @@ RATE_QEI = "tb/count_rate/test_count_rate_qei.py"  # COUNT and EVENTS at the cou
 WB1 = "tb/enc_qei/*[enc_qei_wb-c32-t32]"  # one channel, full profile, COUNT_W 32 / TS_W 32
 AX1 = "tb/enc_qei/*[enc_qei_axil-c64-t16]"  # one channel, full profile, COUNT_W 64 / TS_W 16
 WB3 = "tb/enc_qei/test_channels.py::*[enc_qei_wb-ch3-full]"  # three full channels
-AX4 = "tb/enc_qei/test_channels.py::*[enc_qei_axil-ch4-lean]"  # four lean channels
 QEI_FIRST = ("register_walk", "register_patterns", "events_and_irq", "reset_mid_motion")
 
 
@@ -71,7 +70,7 @@ MODULES: dict[str, Module] = {
                         channels=True),
     "enc_qei": qei("rtl/enc_qei.v", (AX1, WB3), "irq_low_in_reset", "irq_summary",
                    "global_snapshot", "snapshot_wide_values", channels=True),
-    "enc_qei_channel": qei("rtl/enc_qei_channel.v", (WB1, AX4), "swap_and_invert",
+    "enc_qei_channel": qei("rtl/enc_qei_channel.v", (WB1, AX1), "swap_and_invert",
                            "filter_lengths", "snapshot_wide_values", "independent_walks",
                            channels=True),
     "enc_qei_timebase": qei("rtl/enc_qei_timebase.v", (AX1,), "prescaler_and_snap_in",
