@@ -23,10 +23,13 @@ mutants in ``MUT_LOOP_IDS``, in one simulator process:
   run's time + 1 ms (non-lazy), else ``MUT_LOOP_LIMIT_NS``. A mutant that hits it is killed by
   "timeout" (the flow checks that the test takes at most half the limit on the unmutated design:
   a tighter limit could not tell a slow mutant from a wrong one).
+- ``MUT_LOOP_CAP``: a mutant still alive after that share of the tests stops, "capped" (the flow
+  checks it for equivalence, and resumes it in a new process after the tests it passed:
+  ``MUT_LOOP_RESUME``). ``MUT_LOOP_VERIFIED``: tests shown to pass unmutated in an earlier process.
 
 cocotb runs the module's Test objects ("slots", registered below) one after the other; each slot
 asks the loop which (mutant, test) comes next, selects the mutant, runs the test's coroutine under
-the limit, records the outcome itself and finishes normally. A task the test started that raises
+the limit, records the outcome itself and finishes normally (the slots left over pass at once). A task the test started that raises
 makes cocotb end the slot; the slot records that as a failure of the test.
 
 Progress and verdicts go to ``MUT_LOOP_RESULTS`` (JSON, rewritten at the start and end of every
