@@ -367,6 +367,29 @@ async def global_snapshot_one_channel(dut):
     assert gaps == [period] * 3, f"GSNAP_TIMEs {[hex(t) for t in times]}: gaps {gaps}, GSNAP_PERIOD {period}"
 
 
+@cocotb_test()
+async def unit_timer_high_bits(dut):
+    """SNAP_PERIOD and GSNAP_PERIOD with a high bit set (bit TS_W - 1, then bits 12 .. 15, each with
+    3 ticks more): no snapshot within 600 clocks of setting PERIOD_EN (a period bit lost on its
+    way to a timer would make it fire after a few ticks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    ready = event_bits("SNAP_READY")
+    ts_w = int(dut.TS_W.value)
+    for bit in sorted({ts_w - 1, 15, 14, 13, 12}, reverse=True):
+        period = 1 << bit | 3
+        for reg, ctrl_reg in (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL")):
+            await bus.wr(reg, period)
+            await bus.events()
+            await bus.wr(ctrl_reg, pack(ctrl_reg, PERIOD_EN=1))
+            await ClockCycles(dut.clk, 600)
+            ev = await bus.rd("EVENTS")
+            await bus.wr(ctrl_reg, 0)
+            assert not ev & ready, f"{reg} {period:#x}: a snapshot within 600 clocks"
+            await bus.wr(reg, 0)
+    await bus.events()
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_snapshots(top, count_w, ts_w):
