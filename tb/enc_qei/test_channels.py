@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import cocotb
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotbext.quadrature import QuadratureDriver, SharedVector
-from hedsmodel import QUAD, random_walk
+from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
 from enctools.qei.env import FILTER, begin, build_name, channel_envs
@@ -306,6 +306,122 @@ async def irq_summary(dut):
     for env in envs:
         await env.bus.wr("IRQ_EN", 0)
 
+
+@cocotb_test()
+async def lanes_probe_compare_per_channel(dut):
+    """Per channel, through its own page and pins: a PRESET_LO write with each byte-enable mask
+    (contiguous lanes on AXI4-Lite) keeps the other lanes; a rising edge of that channel's bit of
+    probe_in raises its PROBE event within a few clocks (while the pin is still high) and no other
+    channel's; a compare match on a full channel pulses its bit of cmp_out only (cmp_out is 0
+    while nothing matches); SNAP_DELTA between two SNAP_CTRL.CMD writes is the steps between them
+    (each access is one request). On Wishbone, a read abandoned on a channel's page gets no ACK or
+    ERR, and the read right after it is answered with its own register."""
+    envs, rng = await start_channels(dut)
+    n = len(envs)
+    probe_ev = regmap()["EVENTS"].fields["PROBE"].mask
+    seen = [0]
+
+    async def watch_cmp():
+        while True:
+            await RisingEdge(dut.clk)
+            seen[0] |= int(dut.cmp_out.value)
+
+    watcher = cocotb.start_soon(watch_cmp())
+    masks = (1, 2, 4, 8, 3, 6, 12, 7, 14) + ((5, 9, 10, 13, 11) if envs[0].bus.kind == "wb" else ())
+    for k, env in enumerate(envs):
+        bus = env.bus
+        for i, strb in enumerate(masks):
+            lanes = sum(0xFF << 8 * j for j in range(4) if strb >> j & 1)
+            old = (0xC3A55A3C * (i + 7 * k + 1)) & 0xFFFFFFFF
+            new = ~old & 0xFFFFFFFF
+            await bus.wr("PRESET_LO", old)
+            await bus.wr("PRESET_LO", new, strb)
+            got = await bus.rd("PRESET_LO")
+            assert got == old & ~lanes | new & lanes, \
+                f"channel {k} PRESET_LO strb {strb:#x}: {got:#010x}, old {old:#010x}, new {new:#010x}"
+        await bus.wr("PRESET_LO", 0)
+        if env.lean:  # (no probe unit)
+            continue
+        for e in envs:
+            await e.bus.events()
+        await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
+        await FallingEdge(dut.clk)
+        dut.probe_in.value = 1 << k
+        await ClockCycles(dut.clk, FILTER + 8)
+        ev = await bus.rd("EVENTS")
+        assert ev & probe_ev, f"channel {k}: no PROBE event while its probe_in is high (EVENTS {ev:#x})"
+        await FallingEdge(dut.clk)
+        dut.probe_in.value = 0
+        await ClockCycles(dut.clk, FILTER + 8)
+        await bus.wr("PROBE_CTRL", 0)
+        for j, e in enumerate(envs):
+            if j != k:
+                ev = await e.bus.events()
+                assert "PROBE" not in ev, f"probe_in of channel {k} raised PROBE on channel {j}"
+    assert seen[0] == 0, f"cmp_out {seen[0]:#x} with no compare match"
+    for k, env in enumerate(envs):
+        if env.lean:  # (no compare unit)
+            continue
+        model = QeiModel(env.count_w)
+        await env.setup(model, count=100, compare=101, filter_len=1)
+        seen[0] = 0
+        await env.play(walk([1, 1], [20 * T_NS, 20 * T_NS], start_pos=env.pos), model)
+        assert seen[0] == 1 << k, f"channel {k}: cmp_out {seen[0]:#x} after its compare match"
+        await env.bus.wr("COMPARE_LO", 0)
+    watcher.cancel()
+    # one request per bus access: SNAP_DELTA between two SNAP_CTRL.CMD writes is the steps played
+    # between them (a repeated CMD write would take a second snapshot with no steps)
+    for k, env in enumerate(envs):
+        await env.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+        await env.settle(4)
+        await env.play(walk([1] * 5, [8 * T_NS] * 5, start_pos=env.pos), None)
+        await env.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+        await env.settle(4)
+        delta = await env.bus.rd("SNAP_DELTA")
+        assert delta == 5, f"channel {k}: SNAP_DELTA {delta:#x} over 5 steps between two commands"
+        await env.bus.events()
+    if envs[0].bus.kind != "wb":
+        return
+    for k in range(n):
+        bus = envs[k].bus
+        ctrl = await bus.rd("CTRL")
+        marker = 0x5EED_0000 | k
+        await bus.wr("PRESET_LO", marker)
+        for hold in (1, 2):
+            # a read of CTRL abandoned after `hold` clocks, then at once a read of PRESET_LO: its
+            # answer is PRESET_LO's, never the abandoned read's
+            await FallingEdge(dut.clk)
+            dut.wb_adr_i.value = k * PAGE + regmap()["CTRL"].offset
+            dut.wb_we_i.value = 0
+            dut.wb_sel_i.value = 0xF
+            dut.wb_cyc_i.value = 1
+            dut.wb_stb_i.value = 1
+            await ClockCycles(dut.clk, hold)
+            await FallingEdge(dut.clk)
+            dut.wb_cyc_i.value = 0
+            dut.wb_stb_i.value = 0
+            await Timer(PERIOD_PS // 10, unit="ps")  # the same clock, CYC already low
+            assert dut.wb_ack_o.value == 0 and dut.wb_err_o.value == 0, \
+                f"page {k}: ACK/ERR after the master dropped CYC"
+            await FallingEdge(dut.clk)
+            dut.wb_adr_i.value = k * PAGE + regmap()["PRESET_LO"].offset
+            dut.wb_cyc_i.value = 1
+            dut.wb_stb_i.value = 1
+            for c in range(20):  # ACK / ERR as the master samples them at the next rising edge
+                await Timer(PERIOD_PS // 10, unit="ps")
+                if dut.wb_ack_o.value or dut.wb_err_o.value:
+                    break
+                await FallingEdge(dut.clk)
+            ack, err, data = int(dut.wb_ack_o.value), int(dut.wb_err_o.value), int(dut.wb_dat_o.value)
+            await FallingEdge(dut.clk)
+            dut.wb_cyc_i.value = 0
+            dut.wb_stb_i.value = 0
+            assert ack and not err and data == marker, \
+                f"page {k}, CTRL read abandoned after {hold} clock(s): the next read (PRESET_LO " \
+                f"{marker:#x}) answered ACK {ack} ERR {err} data {data:#x}"
+            await ClockCycles(dut.clk, 4)
+        assert await bus.rd("CTRL") == ctrl
+        await bus.wr("PRESET_LO", 0)
 
 # ---- pytest --------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,channels,profile,count_w,ts_w", CHANNEL_CONFIGS,
