@@ -21,7 +21,7 @@
 //     enabled lane, a set in the clock of the clear wins;
 //   - saturating counters: +1 per strobe up to all ones, any write clears (keeping a strobe of
 //     its clock);
-//   - a unit the build leaves out (TIMING, RANGE, PROBE, PERIOD = 0) reads 0 in its fields; a
+//   - a unit the build leaves out (TIMING, RANGE, PROBE, PERIOD, EFIFO = 0) reads 0 in its fields; a
 //     fixed field (FIXED_FUNC >= 0) reads the fixed value;
 //   - a write-1 pulse field (SNAP_CTRL.CMD, GSNAP_CTRL.CMD) gives one reg2hw pulse of its
 //     channel (or of the global group) in the clock after a write of 1 to it in its lane, and
@@ -39,6 +39,7 @@ module enc_qei_regs_formal #(
     parameter integer RANGE      = 1,
     parameter integer PROBE      = 1,
     parameter integer PERIOD     = 1,
+    parameter integer EFIFO      = 1,
     parameter integer FIXED_FUNC = -1,
     parameter integer CHANNELS   = 2,
     parameter integer COUNT_W    = 40,
@@ -79,6 +80,7 @@ module enc_qei_regs_formal #(
       .RANGE     (RANGE),
       .PROBE     (PROBE),
       .PERIOD    (PERIOD),
+      .EFIFO     (EFIFO),
       .FIXED_FUNC(FIXED_FUNC),
       .CHANNELS  (CHANNELS),
       .ADDR_W    (AW),
@@ -136,7 +138,8 @@ module enc_qei_regs_formal #(
   wire [31:0] t_absent = ((TIMING == 0) ? ENC_QEI_T_F_TIMING[f_k*32 +: 32] : 32'd0) |
                          ((RANGE == 0) ? ENC_QEI_T_F_RANGE[f_k*32 +: 32] : 32'd0) |
                          ((PROBE == 0) ? ENC_QEI_T_F_PROBE[f_k*32 +: 32] : 32'd0) |
-                         ((PERIOD == 0) ? ENC_QEI_T_F_PERIOD[f_k*32 +: 32] : 32'd0);
+                         ((PERIOD == 0) ? ENC_QEI_T_F_PERIOD[f_k*32 +: 32] : 32'd0) |
+                         ((EFIFO == 0) ? ENC_QEI_T_F_EFIFO[f_k*32 +: 32] : 32'd0);
   wire [31:0] t_fixed  = ENC_QEI_T_FIXED[f_k*32 +: 32];
   wire [1:0]  t_coh    = ENC_QEI_T_COH[f_k*2 +: 2];
 

@@ -25,6 +25,8 @@
 //                3 lean      count functions, free count, index, timebase, snapshots with edge
 //                            time and deltas, QERR / GLITCH; no probe, compare, range modes,
 //                            period capture, stall or per-channel unit timer; COUNT_W >= 32
+//   EFIFO_LOG2 0: no edge-capture FIFO; 1 .. 8: every channel has one of 2^EFIFO_LOG2 entries
+//              (CAPS.EFIFO_LOG2, EFIFO_* registers); needs the timing unit (PROFILE full or lean)
 //   FUNC_MASK  the count functions built, bit F for CTRL.FUNC value F (default: all). With one
 //              bit set the function is fixed: CTRL.FUNC reads it and ignores writes, and the
 //              decode logic of the others is left out. With several, a CTRL.FUNC value outside
@@ -38,7 +40,8 @@ module enc_qei #(
     parameter integer COUNT_W    = 32,   // counter width in bits
     parameter integer TS_W       = 32,   // timebase / timestamp width in bits
     parameter integer PROFILE    = 2,    // 2 full, 1 counting, 3 lean (see above)
-    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL   // count functions built: bit F = CTRL.FUNC value F
+    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL,  // count functions built: bit F = CTRL.FUNC value F
+    parameter integer EFIFO_LOG2 = 0     // edge-capture FIFO of 2^EFIFO_LOG2 entries per channel, 0: none
 ) (
     input  wire                clk,
     input  wire                rst,         // synchronous, active high
@@ -66,6 +69,7 @@ module enc_qei #(
     `ENC_CHECK_TS_W
     `ENC_CHECK_PROFILE
     `ENC_CHECK_FUNC_MASK
+    `ENC_CHECK_EFIFO_LOG2
     // (ADDR_W must hold the pages: a relation enc_ip.core's ranges cannot hold)
     if ((1 << (ADDR_W - 8)) < CHANNELS) begin : g_bad_addr_w_pages
 `ifdef __ICARUS__
@@ -86,6 +90,7 @@ module enc_qei #(
   localparam integer RANGE  = (PROFILE == P_FULL || PROFILE == P_CNT) ? 1 : 0;
   localparam integer PROBE  = RANGE;
   localparam integer PERIOD = (PROFILE == P_FULL) ? 1 : 0;
+  localparam integer EFIFO  = (EFIFO_LOG2 != 0) ? 1 : 0;
 
   generate
     // (the lean profile's count is a free-running 32..64-bit count)
@@ -94,6 +99,14 @@ module enc_qei #(
       enc_qei__parameter_COUNT_W_must_be_at_least_32_with_PROFILE_lean u_stop ();
 `else
       $error("enc_qei: PROFILE lean (3) needs COUNT_W of at least 32");
+`endif
+    end
+    // (the edge FIFO timestamps with the timing unit's timebase)
+    if (EFIFO_LOG2 != 0 && TIMING == 0) begin : g_bad_efifo_profile
+`ifdef __ICARUS__
+      enc_qei__parameter_EFIFO_LOG2_needs_PROFILE_full_or_lean u_stop ();
+`else
+      $error("enc_qei: parameter EFIFO_LOG2 > 0 needs the timing unit (PROFILE 2 full or 3 lean)");
 `endif
     end
   endgenerate
@@ -134,6 +147,7 @@ module enc_qei #(
       .RANGE     (RANGE),
       .PROBE     (PROBE),
       .PERIOD    (PERIOD),
+      .EFIFO     (EFIFO),
       .FIXED_FUNC(FIXED_FUNC),
       .CHANNELS  (CHANNELS),
       .ADDR_W    (ADDR_W),
@@ -160,6 +174,7 @@ module enc_qei #(
   localparam [7:0] TS_W8      = TS_W[7:0];
   localparam [2:0] PROFILE3   = PROFILE[2:0];
   localparam [4:0] CHANNELS5  = CHANNELS[4:0];
+  localparam [3:0] EFIFO_LOG24 = EFIFO_LOG2[3:0];
 
   assign h2r_caps_count_w  = COUNT_W8;
   assign h2r_caps_ts_w     = TS_W8;
@@ -168,6 +183,7 @@ module enc_qei #(
   assign h2r_caps_timing   = (TIMING != 0);
   assign h2r_caps_profile  = PROFILE3;
   assign h2r_caps_channels = CHANNELS5;
+  assign h2r_caps_efifo_log2 = EFIFO_LOG24;
 
   // ---- the timebase and the global snapshot: one for every channel -------------------------
   wire [TS_W-1:0] timebase;
@@ -235,7 +251,8 @@ module enc_qei #(
           .TIMING    (TIMING),
           .RANGE     (RANGE),
           .PROBE     (PROBE),
-          .PERIOD    (PERIOD)
+          .PERIOD    (PERIOD),
+          .EFIFO_LOG2(EFIFO_LOG2)
       ) u_chan (
           .clk     (clk),
           .rst     (rst),

@@ -26,17 +26,21 @@ wire r2h_index_ctrl_arm = reg2hw[280];  // INDEX_CTRL.ARM
 wire r2h_probe_ctrl_en = reg2hw[281];  // PROBE_CTRL.EN
 wire r2h_probe_ctrl_edge = reg2hw[282];  // PROBE_CTRL.EDGE
 wire r2h_probe_ctrl_once = reg2hw[283];  // PROBE_CTRL.ONCE
-wire [11:0] r2h_events = reg2hw[295:284];  // EVENTS: pending bits
-wire [11:0] r2h_irq_en_en = reg2hw[307:296];  // IRQ_EN.EN
-wire r2h_snap_ctrl_cmd = reg2hw[308];  // SNAP_CTRL.CMD
-wire r2h_snap_ctrl_in_en = reg2hw[309];  // SNAP_CTRL.IN_EN
-wire r2h_snap_ctrl_period_en = reg2hw[310];  // SNAP_CTRL.PERIOD_EN
-wire r2h_snap_ctrl_edge = reg2hw[311];  // SNAP_CTRL.EDGE
-wire [31:0] r2h_snap_period = reg2hw[343:312];  // SNAP_PERIOD.VALUE
-wire r2h_period_ctrl_en = reg2hw[344];  // PERIOD_CTRL.EN
-wire r2h_period_ctrl_edge = reg2hw[345];  // PERIOD_CTRL.EDGE
-wire [7:0] r2h_period_ctrl_n = reg2hw[353:346];  // PERIOD_CTRL.N
-wire [31:0] r2h_stall_timeout = reg2hw[385:354];  // STALL_TIMEOUT.VALUE
+wire [13:0] r2h_events = reg2hw[297:284];  // EVENTS: pending bits
+wire [13:0] r2h_irq_en_en = reg2hw[311:298];  // IRQ_EN.EN
+wire r2h_snap_ctrl_cmd = reg2hw[312];  // SNAP_CTRL.CMD
+wire r2h_snap_ctrl_in_en = reg2hw[313];  // SNAP_CTRL.IN_EN
+wire r2h_snap_ctrl_period_en = reg2hw[314];  // SNAP_CTRL.PERIOD_EN
+wire r2h_snap_ctrl_edge = reg2hw[315];  // SNAP_CTRL.EDGE
+wire [31:0] r2h_snap_period = reg2hw[347:316];  // SNAP_PERIOD.VALUE
+wire r2h_period_ctrl_en = reg2hw[348];  // PERIOD_CTRL.EN
+wire r2h_period_ctrl_edge = reg2hw[349];  // PERIOD_CTRL.EDGE
+wire [7:0] r2h_period_ctrl_n = reg2hw[357:350];  // PERIOD_CTRL.N
+wire [31:0] r2h_stall_timeout = reg2hw[389:358];  // STALL_TIMEOUT.VALUE
+wire r2h_efifo_ctrl_en = reg2hw[390];  // EFIFO_CTRL.EN
+wire r2h_efifo_ctrl_clear = reg2hw[391];  // EFIFO_CTRL.CLEAR
+wire [8:0] r2h_efifo_ctrl_thresh = reg2hw[400:392];  // EFIFO_CTRL.THRESH
+wire r2h_efifo_entry_rd = reg2hw[401];  // EFIFO_ENTRY: read (a one-clock strobe, for a read side effect)
 // verilator lint_on UNUSEDSIGNAL
 wire h2r_status_a;  // STATUS.A
 wire h2r_status_b;  // STATUS.B
@@ -52,7 +56,7 @@ wire [63:0] h2r_index_latch;  // INDEX_LATCH_LO / _HI (COUNT_W bits)
 wire h2r_probe_ctrl_en_clr;  // PROBE_CTRL.EN: hardware clear
 wire [63:0] h2r_probe_latch;  // PROBE_LATCH_LO / _HI (COUNT_W bits)
 wire [31:0] h2r_probe_time;  // PROBE_TIME.VALUE
-wire [11:0] h2r_events_set;  // EVENTS: set strobes
+wire [13:0] h2r_events_set;  // EVENTS: set strobes
 wire h2r_qerr_count_incr;  // QERR_COUNT.VALUE: count one
 wire h2r_glitch_count_incr;  // GLITCH_COUNT.VALUE: count one
 wire [63:0] h2r_snap_count;  // SNAP_COUNT_LO / _HI (COUNT_W bits)
@@ -63,4 +67,8 @@ wire [31:0] h2r_snap_edge_delta;  // SNAP_EDGE_DELTA.VALUE
 wire h2r_period_ctrl_overflow;  // PERIOD_CTRL.OVERFLOW
 wire h2r_period_ctrl_dir_change;  // PERIOD_CTRL.DIR_CHANGE
 wire [31:0] h2r_period;  // PERIOD.VALUE
-assign hw2reg = {h2r_period, h2r_period_ctrl_dir_change, h2r_period_ctrl_overflow, h2r_snap_edge_delta, h2r_snap_delta, h2r_snap_edge_time, h2r_snap_time, h2r_snap_count, h2r_glitch_count_incr, h2r_qerr_count_incr, h2r_events_set, h2r_probe_time, h2r_probe_latch, h2r_probe_ctrl_en_clr, h2r_index_latch, h2r_index_ctrl_arm_clr, h2r_count, h2r_status_valid, h2r_status_stopped, h2r_status_stalled, h2r_status_index_armed, h2r_status_dir, h2r_status_z, h2r_status_b, h2r_status_a};
+wire [8:0] h2r_efifo_status_level;  // EFIFO_STATUS.LEVEL
+wire [31:0] h2r_efifo_entry;  // EFIFO_ENTRY: the live fields at their register positions (other bits unused)
+wire [31:0] h2r_efifo_time;  // EFIFO_TIME.VALUE
+wire h2r_efifo_lost_incr;  // EFIFO_LOST.VALUE: count one
+assign hw2reg = {h2r_efifo_lost_incr, h2r_efifo_time, h2r_efifo_entry, h2r_efifo_status_level, h2r_period, h2r_period_ctrl_dir_change, h2r_period_ctrl_overflow, h2r_snap_edge_delta, h2r_snap_delta, h2r_snap_edge_time, h2r_snap_time, h2r_snap_count, h2r_glitch_count_incr, h2r_qerr_count_incr, h2r_events_set, h2r_probe_time, h2r_probe_latch, h2r_probe_ctrl_en_clr, h2r_index_latch, h2r_index_ctrl_arm_clr, h2r_count, h2r_status_valid, h2r_status_stopped, h2r_status_stalled, h2r_status_index_armed, h2r_status_dir, h2r_status_z, h2r_status_b, h2r_status_a};

@@ -8,6 +8,7 @@
 //                                                            |   range, index, probe, compare)
 //   snap_in, SNAP_CTRL -> enc_qei_snaptrig --(| gsnap)--> enc_qei_timing (snapshots, period,
 //                                                            stall; on the shared timebase)
+//   the core's steps -> enc_qei_efifo (EFIFO_LOG2 > 0: the edge-capture FIFO, EFIFO_*)
 //
 // Z and probe_in go through their own synchronizer and filter of the same length as A and B, so
 // the index lines up with the channels clock for clock. A snapshot is taken in the clock of its
@@ -26,7 +27,8 @@ module enc_qei_channel #(
     parameter integer TIMING     = 1,    // units, as enc_qei_regs's (checked by enc_qei)
     parameter integer RANGE      = 1,
     parameter integer PROBE      = 1,
-    parameter integer PERIOD     = 1
+    parameter integer PERIOD     = 1,
+    parameter integer EFIFO_LOG2 = 0     // edge FIFO of 2^EFIFO_LOG2 entries, 0: none (checked by enc_qei)
 ) (
     input  wire             clk,
     input  wire             rst,       // synchronous, active high
@@ -109,6 +111,7 @@ module enc_qei_channel #(
   wire [COUNT_W-1:0] count_q, idx_latch, probe_latch;
   wire [TS_W-1:0]    probe_time;
   wire step_up, step_dn, applied_up, applied_dn, edge_any, edge_a_rise;
+  wire [1:0] step_ab;
   wire ev_overflow, ev_underflow, ev_index, ev_probe, ev_cmp, ev_qerr, ev_dir_change;
 
   enc_qei_core #(
@@ -165,6 +168,7 @@ module enc_qei_channel #(
       .applied_dn   (applied_dn),
       .edge_any     (edge_any),
       .edge_a_rise  (edge_a_rise),
+      .step_ab      (step_ab),
       .ev_overflow  (ev_overflow),
       .ev_underflow (ev_underflow),
       .ev_index     (ev_index),
@@ -182,7 +186,7 @@ module enc_qei_channel #(
   assign h2r_qerr_count_incr = ev_qerr;
 
   // ---- timing: snapshots, period capture, stall ------------------------------------------------
-  wire ev_snap, ev_period, ev_period_ovf, ev_stall;
+  wire ev_snap, ev_period, ev_period_ovf, ev_stall, ev_efifo_thresh, ev_efifo_ovf;
 
   generate
     if (TIMING != 0) begin : g_timing
@@ -242,13 +246,52 @@ module enc_qei_channel #(
           .ev_stall       (ev_stall)
       );
 
+      if (EFIFO_LOG2 != 0) begin : g_efifo
+        wire [TS_W-1:0] efifo_time;
+
+        enc_qei_efifo #(
+            .DEPTH_LOG2(EFIFO_LOG2),
+            .TS_W      (TS_W)
+        ) u_efifo (
+            .clk      (clk),
+            .rst      (rst),
+            .timebase (timebase),
+            .step_up  (step_up),
+            .step_dn  (step_dn),
+            .step_ab  (step_ab),
+            .ev_index (ev_index),
+            .en       (r2h_efifo_ctrl_en),
+            .clear    (r2h_efifo_ctrl_clear),
+            .thresh   (r2h_efifo_ctrl_thresh),
+            .pop      (r2h_efifo_entry_rd),
+            .entry    (h2r_efifo_entry),
+            .pop_time (efifo_time),
+            .level    (h2r_efifo_status_level),
+            .ev_thresh(ev_efifo_thresh),
+            .ev_ovf   (ev_efifo_ovf),
+            .lost_incr(h2r_efifo_lost_incr)
+        );
+
+        assign h2r_efifo_time = zext_ts(efifo_time);
+      end else begin : g_no_efifo
+        wire unused_efifo = &{1'b0, step_ab, r2h_efifo_ctrl_en, r2h_efifo_ctrl_clear,
+                              r2h_efifo_ctrl_thresh, r2h_efifo_entry_rd};
+        assign h2r_efifo_entry        = 32'd0;
+        assign h2r_efifo_time         = 32'd0;
+        assign h2r_efifo_status_level = 9'd0;
+        assign h2r_efifo_lost_incr    = 1'b0;
+        assign ev_efifo_thresh        = 1'b0;
+        assign ev_efifo_ovf           = 1'b0;
+      end
+
       assign h2r_snap_count     = zext_count(snap_count);
       assign h2r_snap_time      = zext_ts(snap_time);
       assign h2r_snap_edge_time = zext_ts(snap_edge_time);
       assign h2r_period         = zext_ts(period);
     end else begin : g_no_timing
       wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn, applied_up, applied_dn,
-                             snap_in, tick, gsnap};
+                             snap_in, tick, gsnap, step_ab, r2h_efifo_ctrl_en, r2h_efifo_ctrl_clear,
+                             r2h_efifo_ctrl_thresh, r2h_efifo_entry_rd};
       assign h2r_snap_count             = 64'd0;
       assign h2r_snap_time              = 32'd0;
       assign h2r_snap_edge_time         = 32'd0;
@@ -262,6 +305,12 @@ module enc_qei_channel #(
       assign ev_period                  = 1'b0;
       assign ev_period_ovf              = 1'b0;
       assign ev_stall                   = 1'b0;
+      assign h2r_efifo_entry            = 32'd0;
+      assign h2r_efifo_time             = 32'd0;
+      assign h2r_efifo_status_level     = 9'd0;
+      assign h2r_efifo_lost_incr        = 1'b0;
+      assign ev_efifo_thresh            = 1'b0;
+      assign ev_efifo_ovf               = 1'b0;
     end
   endgenerate
 
@@ -279,6 +328,8 @@ module enc_qei_channel #(
   assign h2r_events_set[ENC_QEI_EVENTS_SNAP_READY]   = ev_snap;
   assign h2r_events_set[ENC_QEI_EVENTS_PERIOD_READY] = ev_period;
   assign h2r_events_set[ENC_QEI_EVENTS_PERIOD_OVF]   = ev_period_ovf;
+  assign h2r_events_set[ENC_QEI_EVENTS_EFIFO_THRESH] = ev_efifo_thresh;
+  assign h2r_events_set[ENC_QEI_EVENTS_EFIFO_OVF]    = ev_efifo_ovf;
 
   reg irq_q;
 

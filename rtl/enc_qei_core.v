@@ -86,6 +86,7 @@ module enc_qei_core #(
     output wire               applied_dn,
     output wire               edge_any,       // valid quadrature transition (latency as cnt)
     output wire               edge_a_rise,    // rising edge of A
+    output wire [1:0]         step_ab,        // {A, B} after the transition of this clock's step
     // events (one clock each)
     output wire               ev_overflow,
     output wire               ev_underflow,
@@ -224,6 +225,7 @@ module enc_qei_core #(
   // One register stage between the count function and the count (for Fmax): the steps, the
   // edges and the index hit below are all delayed alike.
   reg step_up_q, step_dn_q, edge_any_q, edge_a_rise_q;
+  reg [1:0] step_ab_q;  // {A, B} after the transition of this clock's step (not reset: a delay)
 
   always @(posedge clk) begin
     if (rst) begin
@@ -239,6 +241,10 @@ module enc_qei_core #(
     end
   end
 
+  always @(posedge clk) begin
+    step_ab_q <= {a1_q, b1_q};
+  end
+
   // a copy of step_dn for the count's adder alone ((* keep *): Yosys would merge it back; Fmax:
   // one register driving the adder's carry chains and the range logic is a long net)
   reg step_dn_add_q;
@@ -251,6 +257,7 @@ module enc_qei_core #(
   assign step_dn     = step_dn_q;
   assign edge_any    = edge_any_q;
   assign edge_a_rise = edge_a_rise_q;
+  assign step_ab     = step_ab_q;
   assign ev_qerr     = quad & x4_err;
 
   // ---- configuration, one clock late (Fmax) ---------------------------------------------------------

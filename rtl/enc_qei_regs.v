@@ -21,6 +21,7 @@ module enc_qei_regs #(
     parameter integer RANGE = 1,  // 1: unit RANGE present, 0: its registers and fields read 0 (checked by enc_qei)
     parameter integer PROBE = 1,  // 1: unit PROBE present, 0: its registers and fields read 0 (checked by enc_qei)
     parameter integer PERIOD = 1,  // 1: unit PERIOD present, 0: its registers and fields read 0 (checked by enc_qei)
+    parameter integer EFIFO = 1,  // 1: unit EFIFO present, 0: its registers and fields read 0 (checked by enc_qei)
     parameter integer FIXED_FUNC = -1,  // -1: the field is storage, >= 0: fixed to it (checked by enc_qei)
     parameter integer CHANNELS = 1,  // channel pages (checked by enc_qei)
     parameter integer ADDR_W   = 8,  // byte address bits, 8 .. 16 (checked by enc_qei)
@@ -41,9 +42,9 @@ module enc_qei_regs #(
     output wire        resp_err,    // no register at that address
     output wire [50:0] reg2hw_g,  // global registers to the hardware
     // verilator lint_off UNUSEDSIGNAL
-    input  wire [106:0] hw2reg_g,  // hardware to the global registers
-    output wire [CHANNELS*386-1:0] reg2hw_ch,  // channel k: bits [k*386 +: 386]
-    input  wire [CHANNELS*474-1:0] hw2reg_ch   // channel k: bits [k*474 +: 474]
+    input  wire [110:0] hw2reg_g,  // hardware to the global registers
+    output wire [CHANNELS*402-1:0] reg2hw_ch,  // channel k: bits [k*402 +: 402]
+    input  wire [CHANNELS*550-1:0] hw2reg_ch   // channel k: bits [k*550 +: 550]
     // verilator lint_on UNUSEDSIGNAL
 );
 
@@ -70,7 +71,7 @@ module enc_qei_regs #(
   wire [7:0]  page_d = addr16[15:8];  // 0 when ADDR_W = 8
   wire [5:0]  off_d  = addr16[7:2];
   wire [7:0] sel_g_d;  // bit k: the offset of global register k, in page 0
-  wire [31:0] sel_c_d;  // bit k: the offset of channel register k
+  wire [36:0] sel_c_d;  // bit k: the offset of channel register k
   assign sel_g_d[0] = (page_d == 8'd0) & (off_d == ENC_QEI_ID[7:2]);
   assign sel_g_d[1] = (page_d == 8'd0) & (off_d == ENC_QEI_CAPS[7:2]);
   assign sel_g_d[2] = (page_d == 8'd0) & (off_d == ENC_QEI_TIMEBASE[7:2]);
@@ -111,12 +112,17 @@ module enc_qei_regs #(
   assign sel_c_d[29] = (off_d == ENC_QEI_PERIOD_CTRL[7:2]);
   assign sel_c_d[30] = (off_d == ENC_QEI_PERIOD[7:2]);
   assign sel_c_d[31] = (off_d == ENC_QEI_STALL_TIMEOUT[7:2]);
+  assign sel_c_d[32] = (off_d == ENC_QEI_EFIFO_CTRL[7:2]);
+  assign sel_c_d[33] = (off_d == ENC_QEI_EFIFO_STATUS[7:2]);
+  assign sel_c_d[34] = (off_d == ENC_QEI_EFIFO_ENTRY[7:2]);
+  assign sel_c_d[35] = (off_d == ENC_QEI_EFIFO_TIME[7:2]);
+  assign sel_c_d[36] = (off_d == ENC_QEI_EFIFO_LOST[7:2]);
   wire chan_page_d = ({8'd0, page_d} < CHANNELS[15:0]);  // a channel's page
 
   // verilator lint_off UNUSEDSIGNAL
   reg [7:0] rd_g_q, wr_g_q;  // a read / write of global register k (read-only ones: unused)
   // verilator lint_on UNUSEDSIGNAL
-  reg [31:0] rd_c_q, wr_c_q;  // a read / write of channel register k, in the page of page_q
+  reg [36:0] rd_c_q, wr_c_q;  // a read / write of channel register k, in the page of page_q
   // verilator lint_off UNUSEDSIGNAL
   reg [CHANNELS-1:0] page_q;  // the request's page, one-hot (all 0: no channel's page)
   // verilator lint_on UNUSEDSIGNAL
@@ -130,16 +136,16 @@ module enc_qei_regs #(
     if (rst) begin
       rd_g_q <= {8{1'b0}};
       wr_g_q <= {8{1'b0}};
-      rd_c_q <= {32{1'b0}};
-      wr_c_q <= {32{1'b0}};
+      rd_c_q <= {37{1'b0}};
+      wr_c_q <= {37{1'b0}};
       page_q <= {CHANNELS{1'b0}};
       err_q  <= 1'b0;
       pend_q <= 1'b0;
     end else begin
       rd_g_q <= (req_valid & ~req_write) ? sel_g_d : {8{1'b0}};
       wr_g_q <= (req_valid & req_write) ? sel_g_d : {8{1'b0}};
-      rd_c_q <= (req_valid & ~req_write & chan_page_d) ? sel_c_d : {32{1'b0}};
-      wr_c_q <= (req_valid & req_write & chan_page_d) ? sel_c_d : {32{1'b0}};
+      rd_c_q <= (req_valid & ~req_write & chan_page_d) ? sel_c_d : {37{1'b0}};
+      wr_c_q <= (req_valid & req_write & chan_page_d) ? sel_c_d : {37{1'b0}};
       for (p = 0; p < CHANNELS; p = p + 1) begin
         page_q[p] <= req_valid & (page_d == p[7:0]);
       end
@@ -215,21 +221,23 @@ module enc_qei_regs #(
   // ---- channel registers: one page per channel ----------------------------------------
   wire [CHANNELS*32-1:0] rd_ch;  // channel k's read data (its selected register)
 `ifdef FORMAL
-  // every channel's f_view (channel k: bits [k*1024 +: 1024]) and staged COUNT_HI
+  // every channel's f_view (channel k: bits [k*1184 +: 1184]) and staged COUNT_HI
   // word (bits [k*32 +: 32]), for formal/enc_qei_regs.sby to connect
-  wire [CHANNELS*1024-1:0] f_view_ch;
+  wire [CHANNELS*1184-1:0] f_view_ch;
   wire [CHANNELS*32-1:0] f_stage_ch;
 `endif
   genvar ch;
   generate
     for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
       // verilator lint_off UNUSEDSIGNAL
-      wire [31:0] wr_c = wr_c_q & {32{page_hit[ch]}};  // writes to this page
-      wire [31:0] rd_c = rd_c_q & {32{page_hit[ch]}};  // reads of this page
+      wire [36:0] wr_c = wr_c_q & {37{page_hit[ch]}};  // writes to this page
+      wire [36:0] rd_c = rd_c_q & {37{page_hit[ch]}};  // reads of this page
       // verilator lint_on UNUSEDSIGNAL
-      wire [385:0] r2h;
-      wire [473:0] h2r = hw2reg_ch[ch*474 +: 474];
-      assign reg2hw_ch[ch*386 +: 386] = r2h;
+      wire [401:0] r2h;
+      // verilator lint_off UNUSEDSIGNAL
+      wire [549:0] h2r = hw2reg_ch[ch*550 +: 550];  // (the unused bits of gapped live registers: EFIFO_ENTRY)
+      // verilator lint_on UNUSEDSIGNAL
+      assign reg2hw_ch[ch*402 +: 402] = r2h;
 
       reg  [31:0] count_hi_latch_q;  // COUNT_HI: the high word latched by a COUNT_LO read
       reg  [31:0] count_hi_stage_q;  // the word a COUNT_HI write staged
@@ -638,24 +646,44 @@ module enc_qei_regs #(
       end
       assign r2h[295] = ((PERIOD != 0) ? events_period_ovf_q : 1'd0);
 
-      reg [11:0] irq_en_en_q;  // IRQ_EN.EN
+      reg events_efifo_thresh_q;  // EVENTS.EFIFO_THRESH
       always @(posedge clk) begin
         if (rst) begin
-          irq_en_en_q <= 12'h0;
-        end else if (wr_c[18]) begin
-          if (wstrb_q[0]) irq_en_en_q[7:0] <= wdata_q[7:0];
-          if (wstrb_q[1]) irq_en_en_q[11:8] <= wdata_q[11:8];
+          events_efifo_thresh_q <= 1'h0;
+        end else begin
+          events_efifo_thresh_q <= (events_efifo_thresh_q & ~({1{wr_c[17]}} & wdata_q[12:12] & bmask[12:12])) | h2r[246];
         end
       end
-      assign r2h[307:296] = irq_en_en_q;
+      assign r2h[296] = ((EFIFO != 0) ? events_efifo_thresh_q : 1'd0);
+
+      reg events_efifo_ovf_q;  // EVENTS.EFIFO_OVF
+      always @(posedge clk) begin
+        if (rst) begin
+          events_efifo_ovf_q <= 1'h0;
+        end else begin
+          events_efifo_ovf_q <= (events_efifo_ovf_q & ~({1{wr_c[17]}} & wdata_q[13:13] & bmask[13:13])) | h2r[247];
+        end
+      end
+      assign r2h[297] = ((EFIFO != 0) ? events_efifo_ovf_q : 1'd0);
+
+      reg [13:0] irq_en_en_q;  // IRQ_EN.EN
+      always @(posedge clk) begin
+        if (rst) begin
+          irq_en_en_q <= 14'h0;
+        end else if (wr_c[18]) begin
+          if (wstrb_q[0]) irq_en_en_q[7:0] <= wdata_q[7:0];
+          if (wstrb_q[1]) irq_en_en_q[13:8] <= wdata_q[13:8];
+        end
+      end
+      assign r2h[311:298] = irq_en_en_q;
 
       reg [15:0] qerr_count_value_q;  // QERR_COUNT.VALUE
       always @(posedge clk) begin
         if (rst) begin
           qerr_count_value_q <= 16'h0;
         end else if (wr_c[19] & (|wstrb_q)) begin
-          qerr_count_value_q <= {{15{1'b0}}, h2r[246]};
-        end else if (h2r[246] & ~(&qerr_count_value_q)) begin
+          qerr_count_value_q <= {{15{1'b0}}, h2r[248]};
+        end else if (h2r[248] & ~(&qerr_count_value_q)) begin
           qerr_count_value_q <= qerr_count_value_q + 16'd1;
         end
       end
@@ -665,8 +693,8 @@ module enc_qei_regs #(
         if (rst) begin
           glitch_count_value_q <= 16'h0;
         end else if (wr_c[20] & (|wstrb_q)) begin
-          glitch_count_value_q <= {{15{1'b0}}, h2r[247]};
-        end else if (h2r[247] & ~(&glitch_count_value_q)) begin
+          glitch_count_value_q <= {{15{1'b0}}, h2r[249]};
+        end else if (h2r[249] & ~(&glitch_count_value_q)) begin
           glitch_count_value_q <= glitch_count_value_q + 16'd1;
         end
       end
@@ -677,7 +705,7 @@ module enc_qei_regs #(
         else if (wr_c[21]) snap_ctrl_cmd_q <= wdata_q[0:0] & bmask[0:0];
         else snap_ctrl_cmd_q <= 1'd0;
       end
-      assign r2h[308] = ((TIMING != 0) ? snap_ctrl_cmd_q : 1'd0);
+      assign r2h[312] = ((TIMING != 0) ? snap_ctrl_cmd_q : 1'd0);
 
       reg snap_ctrl_in_en_q;  // SNAP_CTRL.IN_EN
       always @(posedge clk) begin
@@ -687,7 +715,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_in_en_q <= wdata_q[1:1];
         end
       end
-      assign r2h[309] = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
+      assign r2h[313] = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
 
       reg snap_ctrl_period_en_q;  // SNAP_CTRL.PERIOD_EN
       always @(posedge clk) begin
@@ -697,7 +725,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_period_en_q <= wdata_q[2:2];
         end
       end
-      assign r2h[310] = ((PERIOD != 0) ? snap_ctrl_period_en_q : 1'd0);
+      assign r2h[314] = ((PERIOD != 0) ? snap_ctrl_period_en_q : 1'd0);
 
       reg snap_ctrl_edge_q;  // SNAP_CTRL.EDGE
       always @(posedge clk) begin
@@ -707,7 +735,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_edge_q <= wdata_q[3:3];
         end
       end
-      assign r2h[311] = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
+      assign r2h[315] = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
 
       reg [31:0] snap_period_value_q;  // SNAP_PERIOD.VALUE
       always @(posedge clk) begin
@@ -720,7 +748,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) snap_period_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
-      assign r2h[343:312] = ((PERIOD != 0) ? snap_period_value_q : 32'd0);
+      assign r2h[347:316] = ((PERIOD != 0) ? snap_period_value_q : 32'd0);
 
       reg period_ctrl_en_q;  // PERIOD_CTRL.EN
       always @(posedge clk) begin
@@ -730,7 +758,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) period_ctrl_en_q <= wdata_q[0:0];
         end
       end
-      assign r2h[344] = ((PERIOD != 0) ? period_ctrl_en_q : 1'd0);
+      assign r2h[348] = ((PERIOD != 0) ? period_ctrl_en_q : 1'd0);
 
       reg period_ctrl_edge_q;  // PERIOD_CTRL.EDGE
       always @(posedge clk) begin
@@ -740,7 +768,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) period_ctrl_edge_q <= wdata_q[1:1];
         end
       end
-      assign r2h[345] = ((PERIOD != 0) ? period_ctrl_edge_q : 1'd0);
+      assign r2h[349] = ((PERIOD != 0) ? period_ctrl_edge_q : 1'd0);
 
       reg [7:0] period_ctrl_n_q;  // PERIOD_CTRL.N
       always @(posedge clk) begin
@@ -750,7 +778,7 @@ module enc_qei_regs #(
           if (wstrb_q[1]) period_ctrl_n_q[7:0] <= wdata_q[15:8];
         end
       end
-      assign r2h[353:346] = ((PERIOD != 0) ? period_ctrl_n_q : 8'd0);
+      assign r2h[357:350] = ((PERIOD != 0) ? period_ctrl_n_q : 8'd0);
 
       reg [31:0] stall_timeout_value_q;  // STALL_TIMEOUT.VALUE
       always @(posedge clk) begin
@@ -763,7 +791,50 @@ module enc_qei_regs #(
           if (wstrb_q[3]) stall_timeout_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
-      assign r2h[385:354] = ((PERIOD != 0) ? stall_timeout_value_q : 32'd0);
+      assign r2h[389:358] = ((PERIOD != 0) ? stall_timeout_value_q : 32'd0);
+
+      reg efifo_ctrl_en_q;  // EFIFO_CTRL.EN
+      always @(posedge clk) begin
+        if (rst) begin
+          efifo_ctrl_en_q <= 1'h0;
+        end else if (wr_c[32]) begin
+          if (wstrb_q[0]) efifo_ctrl_en_q <= wdata_q[0:0];
+        end
+      end
+      assign r2h[390] = ((EFIFO != 0) ? efifo_ctrl_en_q : 1'd0);
+
+      reg efifo_ctrl_clear_q;  // EFIFO_CTRL.CLEAR: one-clock pulse
+      always @(posedge clk) begin
+        if (rst) efifo_ctrl_clear_q <= 1'd0;
+        else if (wr_c[32]) efifo_ctrl_clear_q <= wdata_q[1:1] & bmask[1:1];
+        else efifo_ctrl_clear_q <= 1'd0;
+      end
+      assign r2h[391] = ((EFIFO != 0) ? efifo_ctrl_clear_q : 1'd0);
+
+      reg [8:0] efifo_ctrl_thresh_q;  // EFIFO_CTRL.THRESH
+      always @(posedge clk) begin
+        if (rst) begin
+          efifo_ctrl_thresh_q <= 9'h1;
+        end else if (wr_c[32]) begin
+          if (wstrb_q[1]) efifo_ctrl_thresh_q[7:0] <= wdata_q[15:8];
+          if (wstrb_q[2]) efifo_ctrl_thresh_q[8:8] <= wdata_q[16:16];
+        end
+      end
+      assign r2h[400:392] = ((EFIFO != 0) ? efifo_ctrl_thresh_q : 9'd0);
+
+      // EFIFO_ENTRY: a read of it is a strobe to the hardware (swacc: a read side effect)
+      assign r2h[401] = ((EFIFO != 0) ? rd_c[34] : 1'd0);
+
+      reg [15:0] efifo_lost_value_q;  // EFIFO_LOST.VALUE
+      always @(posedge clk) begin
+        if (rst) begin
+          efifo_lost_value_q <= 16'h0;
+        end else if (wr_c[36] & (|wstrb_q)) begin
+          efifo_lost_value_q <= {{15{1'b0}}, h2r[549]};
+        end else if (h2r[549] & ~(&efifo_lost_value_q)) begin
+          efifo_lost_value_q <= efifo_lost_value_q + 16'd1;
+        end
+      end
 
       reg [31:0] rd;
       always @(*) begin
@@ -854,9 +925,11 @@ module enc_qei_regs #(
             if (TIMING != 0) rd[9:9] = rd[9:9] | events_snap_ready_q;  // EVENTS.SNAP_READY
             if (PERIOD != 0) rd[10:10] = rd[10:10] | events_period_ready_q;  // EVENTS.PERIOD_READY
             if (PERIOD != 0) rd[11:11] = rd[11:11] | events_period_ovf_q;  // EVENTS.PERIOD_OVF
+            if (EFIFO != 0) rd[12:12] = rd[12:12] | events_efifo_thresh_q;  // EVENTS.EFIFO_THRESH
+            if (EFIFO != 0) rd[13:13] = rd[13:13] | events_efifo_ovf_q;  // EVENTS.EFIFO_OVF
           end
           if (rd_c_q[18]) begin  // IRQ_EN
-            rd[11:0] = rd[11:0] | irq_en_en_q;  // IRQ_EN.EN
+            rd[13:0] = rd[13:0] | irq_en_en_q;  // IRQ_EN.EN
           end
           if (rd_c_q[19]) begin  // QERR_COUNT
             rd[15:0] = rd[15:0] | qerr_count_value_q;  // QERR_COUNT.VALUE
@@ -873,42 +946,65 @@ module enc_qei_regs #(
             if (PERIOD != 0) rd[31:0] = rd[31:0] | snap_period_value_q;  // SNAP_PERIOD.VALUE
           end
           if (rd_c_q[23]) begin  // SNAP_COUNT_LO
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[279:248];  // SNAP_COUNT_LO.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[281:250];  // SNAP_COUNT_LO.VALUE
           end
           if (rd_c_q[24]) begin  // SNAP_COUNT_HI
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[311:280];  // SNAP_COUNT_HI.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[313:282];  // SNAP_COUNT_HI.VALUE
           end
           if (rd_c_q[25]) begin  // SNAP_TIME
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[343:312];  // SNAP_TIME.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[345:314];  // SNAP_TIME.VALUE
           end
           if (rd_c_q[26]) begin  // SNAP_EDGE_TIME
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[375:344];  // SNAP_EDGE_TIME.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[377:346];  // SNAP_EDGE_TIME.VALUE
           end
           if (rd_c_q[27]) begin  // SNAP_DELTA
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[407:376];  // SNAP_DELTA.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[409:378];  // SNAP_DELTA.VALUE
           end
           if (rd_c_q[28]) begin  // SNAP_EDGE_DELTA
-            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[439:408];  // SNAP_EDGE_DELTA.VALUE
+            if (TIMING != 0) rd[31:0] = rd[31:0] | h2r[441:410];  // SNAP_EDGE_DELTA.VALUE
           end
           if (rd_c_q[29]) begin  // PERIOD_CTRL
             if (PERIOD != 0) rd[0:0] = rd[0:0] | period_ctrl_en_q;  // PERIOD_CTRL.EN
             if (PERIOD != 0) rd[1:1] = rd[1:1] | period_ctrl_edge_q;  // PERIOD_CTRL.EDGE
             if (PERIOD != 0) rd[15:8] = rd[15:8] | period_ctrl_n_q;  // PERIOD_CTRL.N
-            if (PERIOD != 0) rd[16:16] = rd[16:16] | h2r[440];  // PERIOD_CTRL.OVERFLOW
-            if (PERIOD != 0) rd[17:17] = rd[17:17] | h2r[441];  // PERIOD_CTRL.DIR_CHANGE
+            if (PERIOD != 0) rd[16:16] = rd[16:16] | h2r[442];  // PERIOD_CTRL.OVERFLOW
+            if (PERIOD != 0) rd[17:17] = rd[17:17] | h2r[443];  // PERIOD_CTRL.DIR_CHANGE
           end
           if (rd_c_q[30]) begin  // PERIOD
-            if (PERIOD != 0) rd[31:0] = rd[31:0] | h2r[473:442];  // PERIOD.VALUE
+            if (PERIOD != 0) rd[31:0] = rd[31:0] | h2r[475:444];  // PERIOD.VALUE
           end
           if (rd_c_q[31]) begin  // STALL_TIMEOUT
             if (PERIOD != 0) rd[31:0] = rd[31:0] | stall_timeout_value_q;  // STALL_TIMEOUT.VALUE
           end
+          if (rd_c_q[32]) begin  // EFIFO_CTRL
+            if (EFIFO != 0) rd[0:0] = rd[0:0] | efifo_ctrl_en_q;  // EFIFO_CTRL.EN
+            if (EFIFO != 0) rd[16:8] = rd[16:8] | efifo_ctrl_thresh_q;  // EFIFO_CTRL.THRESH
+          end
+          if (rd_c_q[33]) begin  // EFIFO_STATUS
+            if (EFIFO != 0) rd[8:0] = rd[8:0] | h2r[484:476];  // EFIFO_STATUS.LEVEL
+          end
+          if (rd_c_q[34]) begin  // EFIFO_ENTRY
+            if (EFIFO != 0) rd[0:0] = rd[0:0] | h2r[485];  // EFIFO_ENTRY.VALID
+            if (EFIFO != 0) rd[1:1] = rd[1:1] | h2r[486];  // EFIFO_ENTRY.DIR
+            if (EFIFO != 0) rd[2:2] = rd[2:2] | h2r[487];  // EFIFO_ENTRY.A
+            if (EFIFO != 0) rd[3:3] = rd[3:3] | h2r[488];  // EFIFO_ENTRY.B
+            if (EFIFO != 0) rd[4:4] = rd[4:4] | h2r[489];  // EFIFO_ENTRY.LOST
+            if (EFIFO != 0) rd[5:5] = rd[5:5] | h2r[490];  // EFIFO_ENTRY.IDX
+            if (EFIFO != 0) rd[15:8] = rd[15:8] | h2r[500:493];  // EFIFO_ENTRY.LEFT
+            if (EFIFO != 0) rd[31:16] = rd[31:16] | h2r[516:501];  // EFIFO_ENTRY.TIME_LO
+          end
+          if (rd_c_q[35]) begin  // EFIFO_TIME
+            if (EFIFO != 0) rd[31:0] = rd[31:0] | h2r[548:517];  // EFIFO_TIME.VALUE
+          end
+          if (rd_c_q[36]) begin  // EFIFO_LOST
+            if (EFIFO != 0) rd[15:0] = rd[15:0] | efifo_lost_value_q;  // EFIFO_LOST.VALUE
+          end
       end
       assign rd_ch[ch*32 +: 32] = rd;
     `ifdef FORMAL
-      reg [1023:0] f_view;
+      reg [1183:0] f_view;
       always @(*) begin
-        f_view = {1024{1'b0}};
+        f_view = {1184{1'b0}};
         f_view[0 +: 1] = ctrl_en_q;  // CTRL.EN
         f_view[1 +: 1] = ctrl_swap_ab_q;  // CTRL.SWAP_AB
         f_view[2 +: 1] = ctrl_inv_a_q;  // CTRL.INV_A
@@ -960,28 +1056,43 @@ module enc_qei_regs #(
         if (TIMING != 0) f_view[553 +: 1] = events_snap_ready_q;  // EVENTS.SNAP_READY
         if (PERIOD != 0) f_view[554 +: 1] = events_period_ready_q;  // EVENTS.PERIOD_READY
         if (PERIOD != 0) f_view[555 +: 1] = events_period_ovf_q;  // EVENTS.PERIOD_OVF
-        f_view[576 +: 12] = irq_en_en_q;  // IRQ_EN.EN
+        if (EFIFO != 0) f_view[556 +: 1] = events_efifo_thresh_q;  // EVENTS.EFIFO_THRESH
+        if (EFIFO != 0) f_view[557 +: 1] = events_efifo_ovf_q;  // EVENTS.EFIFO_OVF
+        f_view[576 +: 14] = irq_en_en_q;  // IRQ_EN.EN
         f_view[608 +: 16] = qerr_count_value_q;  // QERR_COUNT.VALUE
         f_view[640 +: 16] = glitch_count_value_q;  // GLITCH_COUNT.VALUE
         if (TIMING != 0) f_view[673 +: 1] = snap_ctrl_in_en_q;  // SNAP_CTRL.IN_EN
         if (PERIOD != 0) f_view[674 +: 1] = snap_ctrl_period_en_q;  // SNAP_CTRL.PERIOD_EN
         if (TIMING != 0) f_view[675 +: 1] = snap_ctrl_edge_q;  // SNAP_CTRL.EDGE
         if (PERIOD != 0) f_view[704 +: 32] = snap_period_value_q;  // SNAP_PERIOD.VALUE
-        if (TIMING != 0) f_view[736 +: 32] = h2r[279:248];  // SNAP_COUNT_LO.VALUE
-        if (TIMING != 0) f_view[768 +: 32] = h2r[311:280];  // SNAP_COUNT_HI.VALUE
-        if (TIMING != 0) f_view[800 +: 32] = h2r[343:312];  // SNAP_TIME.VALUE
-        if (TIMING != 0) f_view[832 +: 32] = h2r[375:344];  // SNAP_EDGE_TIME.VALUE
-        if (TIMING != 0) f_view[864 +: 32] = h2r[407:376];  // SNAP_DELTA.VALUE
-        if (TIMING != 0) f_view[896 +: 32] = h2r[439:408];  // SNAP_EDGE_DELTA.VALUE
+        if (TIMING != 0) f_view[736 +: 32] = h2r[281:250];  // SNAP_COUNT_LO.VALUE
+        if (TIMING != 0) f_view[768 +: 32] = h2r[313:282];  // SNAP_COUNT_HI.VALUE
+        if (TIMING != 0) f_view[800 +: 32] = h2r[345:314];  // SNAP_TIME.VALUE
+        if (TIMING != 0) f_view[832 +: 32] = h2r[377:346];  // SNAP_EDGE_TIME.VALUE
+        if (TIMING != 0) f_view[864 +: 32] = h2r[409:378];  // SNAP_DELTA.VALUE
+        if (TIMING != 0) f_view[896 +: 32] = h2r[441:410];  // SNAP_EDGE_DELTA.VALUE
         if (PERIOD != 0) f_view[928 +: 1] = period_ctrl_en_q;  // PERIOD_CTRL.EN
         if (PERIOD != 0) f_view[929 +: 1] = period_ctrl_edge_q;  // PERIOD_CTRL.EDGE
         if (PERIOD != 0) f_view[936 +: 8] = period_ctrl_n_q;  // PERIOD_CTRL.N
-        if (PERIOD != 0) f_view[944 +: 1] = h2r[440];  // PERIOD_CTRL.OVERFLOW
-        if (PERIOD != 0) f_view[945 +: 1] = h2r[441];  // PERIOD_CTRL.DIR_CHANGE
-        if (PERIOD != 0) f_view[960 +: 32] = h2r[473:442];  // PERIOD.VALUE
+        if (PERIOD != 0) f_view[944 +: 1] = h2r[442];  // PERIOD_CTRL.OVERFLOW
+        if (PERIOD != 0) f_view[945 +: 1] = h2r[443];  // PERIOD_CTRL.DIR_CHANGE
+        if (PERIOD != 0) f_view[960 +: 32] = h2r[475:444];  // PERIOD.VALUE
         if (PERIOD != 0) f_view[992 +: 32] = stall_timeout_value_q;  // STALL_TIMEOUT.VALUE
+        if (EFIFO != 0) f_view[1024 +: 1] = efifo_ctrl_en_q;  // EFIFO_CTRL.EN
+        if (EFIFO != 0) f_view[1032 +: 9] = efifo_ctrl_thresh_q;  // EFIFO_CTRL.THRESH
+        if (EFIFO != 0) f_view[1056 +: 9] = h2r[484:476];  // EFIFO_STATUS.LEVEL
+        if (EFIFO != 0) f_view[1088 +: 1] = h2r[485];  // EFIFO_ENTRY.VALID
+        if (EFIFO != 0) f_view[1089 +: 1] = h2r[486];  // EFIFO_ENTRY.DIR
+        if (EFIFO != 0) f_view[1090 +: 1] = h2r[487];  // EFIFO_ENTRY.A
+        if (EFIFO != 0) f_view[1091 +: 1] = h2r[488];  // EFIFO_ENTRY.B
+        if (EFIFO != 0) f_view[1092 +: 1] = h2r[489];  // EFIFO_ENTRY.LOST
+        if (EFIFO != 0) f_view[1093 +: 1] = h2r[490];  // EFIFO_ENTRY.IDX
+        if (EFIFO != 0) f_view[1096 +: 8] = h2r[500:493];  // EFIFO_ENTRY.LEFT
+        if (EFIFO != 0) f_view[1104 +: 16] = h2r[516:501];  // EFIFO_ENTRY.TIME_LO
+        if (EFIFO != 0) f_view[1120 +: 32] = h2r[548:517];  // EFIFO_TIME.VALUE
+        if (EFIFO != 0) f_view[1152 +: 16] = efifo_lost_value_q;  // EFIFO_LOST.VALUE
       end
-      assign f_view_ch[ch*1024 +: 1024] = f_view;
+      assign f_view_ch[ch*1184 +: 1184] = f_view;
       assign f_stage_ch[ch*32 +: 32] = count_hi_stage_q;
     `endif
 
@@ -1006,9 +1117,10 @@ module enc_qei_regs #(
       rd_d[18:18] = rd_d[18:18] | hw2reg_g[18];  // CAPS.TIMING
       rd_d[21:19] = rd_d[21:19] | hw2reg_g[21:19];  // CAPS.PROFILE
       rd_d[26:22] = rd_d[26:22] | hw2reg_g[26:22];  // CAPS.CHANNELS
+      rd_d[30:27] = rd_d[30:27] | hw2reg_g[30:27];  // CAPS.EFIFO_LOG2
     end
     if (rd_g_q[2]) begin  // TIMEBASE
-      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[58:27];  // TIMEBASE.VALUE
+      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[62:31];  // TIMEBASE.VALUE
     end
     if (rd_g_q[3]) begin  // TB_PRESCALE
       if (TIMING != 0) rd_d[15:0] = rd_d[15:0] | tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
@@ -1021,10 +1133,10 @@ module enc_qei_regs #(
       if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | gsnap_period_value_q;  // GSNAP_PERIOD.VALUE
     end
     if (rd_g_q[6]) begin  // GSNAP_TIME
-      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[90:59];  // GSNAP_TIME.VALUE
+      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[94:63];  // GSNAP_TIME.VALUE
     end
     if (rd_g_q[7]) begin  // IRQ_SUMMARY
-      rd_d[15:0] = rd_d[15:0] | hw2reg_g[106:91];  // IRQ_SUMMARY.PENDING
+      rd_d[15:0] = rd_d[15:0] | hw2reg_g[110:95];  // IRQ_SUMMARY.PENDING
     end
     for (k = 0; k < CHANNELS; k = k + 1) begin
       rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_hit[k]}});
@@ -1044,13 +1156,14 @@ module enc_qei_regs #(
     f_view_g[50 +: 1] = hw2reg_g[18];  // CAPS.TIMING
     f_view_g[51 +: 3] = hw2reg_g[21:19];  // CAPS.PROFILE
     f_view_g[54 +: 5] = hw2reg_g[26:22];  // CAPS.CHANNELS
-    if (TIMING != 0) f_view_g[64 +: 32] = hw2reg_g[58:27];  // TIMEBASE.VALUE
+    f_view_g[59 +: 4] = hw2reg_g[30:27];  // CAPS.EFIFO_LOG2
+    if (TIMING != 0) f_view_g[64 +: 32] = hw2reg_g[62:31];  // TIMEBASE.VALUE
     if (TIMING != 0) f_view_g[96 +: 16] = tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
     if (TIMING != 0) f_view_g[129 +: 1] = gsnap_ctrl_in_en_q;  // GSNAP_CTRL.IN_EN
     if (TIMING != 0) f_view_g[130 +: 1] = gsnap_ctrl_period_en_q;  // GSNAP_CTRL.PERIOD_EN
     if (TIMING != 0) f_view_g[160 +: 32] = gsnap_period_value_q;  // GSNAP_PERIOD.VALUE
-    if (TIMING != 0) f_view_g[192 +: 32] = hw2reg_g[90:59];  // GSNAP_TIME.VALUE
-    f_view_g[224 +: 16] = hw2reg_g[106:91];  // IRQ_SUMMARY.PENDING
+    if (TIMING != 0) f_view_g[192 +: 32] = hw2reg_g[94:63];  // GSNAP_TIME.VALUE
+    f_view_g[224 +: 16] = hw2reg_g[110:95];  // IRQ_SUMMARY.PENDING
   end
 `endif
 

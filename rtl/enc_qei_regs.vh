@@ -49,6 +49,11 @@ localparam [7:0] ENC_QEI_GSNAP_CTRL = 8'h90;  // glb
 localparam [7:0] ENC_QEI_GSNAP_PERIOD = 8'h94;  // glb
 localparam [7:0] ENC_QEI_GSNAP_TIME = 8'h98;  // glb
 localparam [7:0] ENC_QEI_IRQ_SUMMARY = 8'h9C;  // glb
+localparam [7:0] ENC_QEI_EFIFO_CTRL = 8'hA0;  // chan
+localparam [7:0] ENC_QEI_EFIFO_STATUS = 8'hA4;  // chan
+localparam [7:0] ENC_QEI_EFIFO_ENTRY = 8'hA8;  // chan
+localparam [7:0] ENC_QEI_EFIFO_TIME = 8'hAC;  // chan
+localparam [7:0] ENC_QEI_EFIFO_LOST = 8'hB0;  // chan
 
 // Field positions: lsb, and _W the width
 localparam integer ENC_QEI_ID_VERSION = 0, ENC_QEI_ID_VERSION_W = 16;
@@ -60,6 +65,7 @@ localparam integer ENC_QEI_CAPS_PROBE = 17, ENC_QEI_CAPS_PROBE_W = 1;
 localparam integer ENC_QEI_CAPS_TIMING = 18, ENC_QEI_CAPS_TIMING_W = 1;
 localparam integer ENC_QEI_CAPS_PROFILE = 19, ENC_QEI_CAPS_PROFILE_W = 3;
 localparam integer ENC_QEI_CAPS_CHANNELS = 22, ENC_QEI_CAPS_CHANNELS_W = 5;
+localparam integer ENC_QEI_CAPS_EFIFO_LOG2 = 27, ENC_QEI_CAPS_EFIFO_LOG2_W = 4;
 localparam integer ENC_QEI_CTRL_EN = 0, ENC_QEI_CTRL_EN_W = 1;
 localparam integer ENC_QEI_CTRL_SWAP_AB = 1, ENC_QEI_CTRL_SWAP_AB_W = 1;
 localparam integer ENC_QEI_CTRL_INV_A = 2, ENC_QEI_CTRL_INV_A_W = 1;
@@ -111,7 +117,9 @@ localparam integer ENC_QEI_EVENTS_STALL = 8, ENC_QEI_EVENTS_STALL_W = 1;
 localparam integer ENC_QEI_EVENTS_SNAP_READY = 9, ENC_QEI_EVENTS_SNAP_READY_W = 1;
 localparam integer ENC_QEI_EVENTS_PERIOD_READY = 10, ENC_QEI_EVENTS_PERIOD_READY_W = 1;
 localparam integer ENC_QEI_EVENTS_PERIOD_OVF = 11, ENC_QEI_EVENTS_PERIOD_OVF_W = 1;
-localparam integer ENC_QEI_IRQ_EN_EN = 0, ENC_QEI_IRQ_EN_EN_W = 12;
+localparam integer ENC_QEI_EVENTS_EFIFO_THRESH = 12, ENC_QEI_EVENTS_EFIFO_THRESH_W = 1;
+localparam integer ENC_QEI_EVENTS_EFIFO_OVF = 13, ENC_QEI_EVENTS_EFIFO_OVF_W = 1;
+localparam integer ENC_QEI_IRQ_EN_EN = 0, ENC_QEI_IRQ_EN_EN_W = 14;
 localparam integer ENC_QEI_QERR_COUNT_VALUE = 0, ENC_QEI_QERR_COUNT_VALUE_W = 16;
 localparam integer ENC_QEI_GLITCH_COUNT_VALUE = 0, ENC_QEI_GLITCH_COUNT_VALUE_W = 16;
 localparam integer ENC_QEI_TIMEBASE_VALUE = 0, ENC_QEI_TIMEBASE_VALUE_W = 32;
@@ -140,6 +148,20 @@ localparam integer ENC_QEI_GSNAP_CTRL_PERIOD_EN = 2, ENC_QEI_GSNAP_CTRL_PERIOD_E
 localparam integer ENC_QEI_GSNAP_PERIOD_VALUE = 0, ENC_QEI_GSNAP_PERIOD_VALUE_W = 32;
 localparam integer ENC_QEI_GSNAP_TIME_VALUE = 0, ENC_QEI_GSNAP_TIME_VALUE_W = 32;
 localparam integer ENC_QEI_IRQ_SUMMARY_PENDING = 0, ENC_QEI_IRQ_SUMMARY_PENDING_W = 16;
+localparam integer ENC_QEI_EFIFO_CTRL_EN = 0, ENC_QEI_EFIFO_CTRL_EN_W = 1;
+localparam integer ENC_QEI_EFIFO_CTRL_CLEAR = 1, ENC_QEI_EFIFO_CTRL_CLEAR_W = 1;
+localparam integer ENC_QEI_EFIFO_CTRL_THRESH = 8, ENC_QEI_EFIFO_CTRL_THRESH_W = 9;
+localparam integer ENC_QEI_EFIFO_STATUS_LEVEL = 0, ENC_QEI_EFIFO_STATUS_LEVEL_W = 9;
+localparam integer ENC_QEI_EFIFO_ENTRY_VALID = 0, ENC_QEI_EFIFO_ENTRY_VALID_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_DIR = 1, ENC_QEI_EFIFO_ENTRY_DIR_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_A = 2, ENC_QEI_EFIFO_ENTRY_A_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_B = 3, ENC_QEI_EFIFO_ENTRY_B_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_LOST = 4, ENC_QEI_EFIFO_ENTRY_LOST_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_IDX = 5, ENC_QEI_EFIFO_ENTRY_IDX_W = 1;
+localparam integer ENC_QEI_EFIFO_ENTRY_LEFT = 8, ENC_QEI_EFIFO_ENTRY_LEFT_W = 8;
+localparam integer ENC_QEI_EFIFO_ENTRY_TIME_LO = 16, ENC_QEI_EFIFO_ENTRY_TIME_LO_W = 16;
+localparam integer ENC_QEI_EFIFO_TIME_VALUE = 0, ENC_QEI_EFIFO_TIME_VALUE_W = 32;
+localparam integer ENC_QEI_EFIFO_LOST_VALUE = 0, ENC_QEI_EFIFO_LOST_VALUE_W = 16;
 
 // Enum codes (RDL enum types), sized to their fields
 localparam [2:0] ENC_QEI_PROFILE_COUNTING = 3'd1;
@@ -177,8 +199,8 @@ localparam integer ENC_QEI_EDGE_TYPE_N = 2;
 
 // The register block's bundles (rtl/enc_qei_regs.v; the fields by name:
 // enc_qei_regs_fields.vh, enc_qei_chan_fields.vh): widths, and each field's lsb
-localparam integer ENC_QEI_R2H_W = 51, ENC_QEI_H2R_W = 107;
-localparam integer ENC_QEI_R2H_CH_W = 386, ENC_QEI_H2R_CH_W = 474;
+localparam integer ENC_QEI_R2H_W = 51, ENC_QEI_H2R_W = 111;
+localparam integer ENC_QEI_R2H_CH_W = 402, ENC_QEI_H2R_CH_W = 550;
 localparam integer ENC_QEI_R2H_TB_PRESCALE_PRESCALE = 0;
 localparam integer ENC_QEI_R2H_GSNAP_CTRL_CMD = 16;
 localparam integer ENC_QEI_R2H_GSNAP_CTRL_IN_EN = 17;
@@ -191,9 +213,10 @@ localparam integer ENC_QEI_H2R_CAPS_PROBE = 17;
 localparam integer ENC_QEI_H2R_CAPS_TIMING = 18;
 localparam integer ENC_QEI_H2R_CAPS_PROFILE = 19;
 localparam integer ENC_QEI_H2R_CAPS_CHANNELS = 22;
-localparam integer ENC_QEI_H2R_TIMEBASE = 27;
-localparam integer ENC_QEI_H2R_GSNAP_TIME = 59;
-localparam integer ENC_QEI_H2R_IRQ_SUMMARY_PENDING = 91;
+localparam integer ENC_QEI_H2R_CAPS_EFIFO_LOG2 = 27;
+localparam integer ENC_QEI_H2R_TIMEBASE = 31;
+localparam integer ENC_QEI_H2R_GSNAP_TIME = 63;
+localparam integer ENC_QEI_H2R_IRQ_SUMMARY_PENDING = 95;
 localparam integer ENC_QEI_R2H_CTRL_EN = 0;
 localparam integer ENC_QEI_R2H_CTRL_SWAP_AB = 1;
 localparam integer ENC_QEI_R2H_CTRL_INV_A = 2;
@@ -218,16 +241,20 @@ localparam integer ENC_QEI_R2H_PROBE_CTRL_EN = 281;
 localparam integer ENC_QEI_R2H_PROBE_CTRL_EDGE = 282;
 localparam integer ENC_QEI_R2H_PROBE_CTRL_ONCE = 283;
 localparam integer ENC_QEI_R2H_EVENTS = 284;
-localparam integer ENC_QEI_R2H_IRQ_EN_EN = 296;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_CMD = 308;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_IN_EN = 309;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_PERIOD_EN = 310;
-localparam integer ENC_QEI_R2H_SNAP_CTRL_EDGE = 311;
-localparam integer ENC_QEI_R2H_SNAP_PERIOD = 312;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_EN = 344;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_EDGE = 345;
-localparam integer ENC_QEI_R2H_PERIOD_CTRL_N = 346;
-localparam integer ENC_QEI_R2H_STALL_TIMEOUT = 354;
+localparam integer ENC_QEI_R2H_IRQ_EN_EN = 298;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_CMD = 312;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_IN_EN = 313;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_PERIOD_EN = 314;
+localparam integer ENC_QEI_R2H_SNAP_CTRL_EDGE = 315;
+localparam integer ENC_QEI_R2H_SNAP_PERIOD = 316;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EN = 348;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_EDGE = 349;
+localparam integer ENC_QEI_R2H_PERIOD_CTRL_N = 350;
+localparam integer ENC_QEI_R2H_STALL_TIMEOUT = 358;
+localparam integer ENC_QEI_R2H_EFIFO_CTRL_EN = 390;
+localparam integer ENC_QEI_R2H_EFIFO_CTRL_CLEAR = 391;
+localparam integer ENC_QEI_R2H_EFIFO_CTRL_THRESH = 392;
+localparam integer ENC_QEI_R2H_EFIFO_ENTRY_RD = 401;
 localparam integer ENC_QEI_H2R_STATUS_A = 0;
 localparam integer ENC_QEI_H2R_STATUS_B = 1;
 localparam integer ENC_QEI_H2R_STATUS_Z = 2;
@@ -243,16 +270,20 @@ localparam integer ENC_QEI_H2R_PROBE_CTRL_EN_CLR = 137;
 localparam integer ENC_QEI_H2R_PROBE_LATCH = 138;
 localparam integer ENC_QEI_H2R_PROBE_TIME = 202;
 localparam integer ENC_QEI_H2R_EVENTS_SET = 234;
-localparam integer ENC_QEI_H2R_QERR_COUNT_INCR = 246;
-localparam integer ENC_QEI_H2R_GLITCH_COUNT_INCR = 247;
-localparam integer ENC_QEI_H2R_SNAP_COUNT = 248;
-localparam integer ENC_QEI_H2R_SNAP_TIME = 312;
-localparam integer ENC_QEI_H2R_SNAP_EDGE_TIME = 344;
-localparam integer ENC_QEI_H2R_SNAP_DELTA = 376;
-localparam integer ENC_QEI_H2R_SNAP_EDGE_DELTA = 408;
-localparam integer ENC_QEI_H2R_PERIOD_CTRL_OVERFLOW = 440;
-localparam integer ENC_QEI_H2R_PERIOD_CTRL_DIR_CHANGE = 441;
-localparam integer ENC_QEI_H2R_PERIOD = 442;
+localparam integer ENC_QEI_H2R_QERR_COUNT_INCR = 248;
+localparam integer ENC_QEI_H2R_GLITCH_COUNT_INCR = 249;
+localparam integer ENC_QEI_H2R_SNAP_COUNT = 250;
+localparam integer ENC_QEI_H2R_SNAP_TIME = 314;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_TIME = 346;
+localparam integer ENC_QEI_H2R_SNAP_DELTA = 378;
+localparam integer ENC_QEI_H2R_SNAP_EDGE_DELTA = 410;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_OVERFLOW = 442;
+localparam integer ENC_QEI_H2R_PERIOD_CTRL_DIR_CHANGE = 443;
+localparam integer ENC_QEI_H2R_PERIOD = 444;
+localparam integer ENC_QEI_H2R_EFIFO_STATUS_LEVEL = 476;
+localparam integer ENC_QEI_H2R_EFIFO_ENTRY = 485;
+localparam integer ENC_QEI_H2R_EFIFO_TIME = 517;
+localparam integer ENC_QEI_H2R_EFIFO_LOST_INCR = 549;
 // verilator lint_on UNUSEDPARAM
 
 // 1: the byte address is a register of a build with `channels` channels
@@ -268,7 +299,7 @@ function enc_qei_mapped;
       default: glb = 1'b0;
     endcase
     case (addr[7:2])
-      6'd2, 6'd3, 6'd4, 6'd5, 6'd6, 6'd7, 6'd8, 6'd9, 6'd10, 6'd11, 6'd12, 6'd13, 6'd14, 6'd15, 6'd16, 6'd17, 6'd18, 6'd19, 6'd20, 6'd21, 6'd22, 6'd25, 6'd26, 6'd27, 6'd28, 6'd29, 6'd30, 6'd31, 6'd32, 6'd33, 6'd34, 6'd35: chan = 1'b1;
+      6'd2, 6'd3, 6'd4, 6'd5, 6'd6, 6'd7, 6'd8, 6'd9, 6'd10, 6'd11, 6'd12, 6'd13, 6'd14, 6'd15, 6'd16, 6'd17, 6'd18, 6'd19, 6'd20, 6'd21, 6'd22, 6'd25, 6'd26, 6'd27, 6'd28, 6'd29, 6'd30, 6'd31, 6'd32, 6'd33, 6'd34, 6'd35, 6'd40, 6'd41, 6'd42, 6'd43, 6'd44: chan = 1'b1;
       default: chan = 1'b0;
     endcase
     enc_qei_mapped = (glb & (addr[15:8] == 8'd0)) | (chan & ({24'd0, addr[15:8]} < channels));

@@ -48,6 +48,9 @@ extern "C" {
 #define ENC_QEI__CAPS__CHANNELS_bm 0x7c00000u
 #define ENC_QEI__CAPS__CHANNELS_bp 22
 #define ENC_QEI__CAPS__CHANNELS_bw 5
+#define ENC_QEI__CAPS__EFIFO_LOG2_bm 0x78000000u
+#define ENC_QEI__CAPS__EFIFO_LOG2_bp 27
+#define ENC_QEI__CAPS__EFIFO_LOG2_bw 4
 
 // reg - CTRL (per channel)
 #define ENC_QEI__CTRL__EN_bm 0x1u
@@ -280,11 +283,19 @@ extern "C" {
 #define ENC_QEI__EVENTS__PERIOD_OVF_bp 11
 #define ENC_QEI__EVENTS__PERIOD_OVF_bw 1
 #define ENC_QEI__EVENTS__PERIOD_OVF_reset 0x0u
+#define ENC_QEI__EVENTS__EFIFO_THRESH_bm 0x1000u
+#define ENC_QEI__EVENTS__EFIFO_THRESH_bp 12
+#define ENC_QEI__EVENTS__EFIFO_THRESH_bw 1
+#define ENC_QEI__EVENTS__EFIFO_THRESH_reset 0x0u
+#define ENC_QEI__EVENTS__EFIFO_OVF_bm 0x2000u
+#define ENC_QEI__EVENTS__EFIFO_OVF_bp 13
+#define ENC_QEI__EVENTS__EFIFO_OVF_bw 1
+#define ENC_QEI__EVENTS__EFIFO_OVF_reset 0x0u
 
 // reg - IRQ_EN (per channel)
-#define ENC_QEI__IRQ_EN__EN_bm 0xfffu
+#define ENC_QEI__IRQ_EN__EN_bm 0x3fffu
 #define ENC_QEI__IRQ_EN__EN_bp 0
-#define ENC_QEI__IRQ_EN__EN_bw 12
+#define ENC_QEI__IRQ_EN__EN_bw 14
 #define ENC_QEI__IRQ_EN__EN_reset 0x0u
 
 // reg - QERR_COUNT (per channel)
@@ -433,6 +444,63 @@ extern "C" {
 #define ENC_QEI__IRQ_SUMMARY__PENDING_bp 0
 #define ENC_QEI__IRQ_SUMMARY__PENDING_bw 16
 
+// reg - EFIFO_CTRL (per channel)
+#define ENC_QEI__EFIFO_CTRL__EN_bm 0x1u
+#define ENC_QEI__EFIFO_CTRL__EN_bp 0
+#define ENC_QEI__EFIFO_CTRL__EN_bw 1
+#define ENC_QEI__EFIFO_CTRL__EN_reset 0x0u
+#define ENC_QEI__EFIFO_CTRL__CLEAR_bm 0x2u
+#define ENC_QEI__EFIFO_CTRL__CLEAR_bp 1
+#define ENC_QEI__EFIFO_CTRL__CLEAR_bw 1
+#define ENC_QEI__EFIFO_CTRL__CLEAR_reset 0x0u
+#define ENC_QEI__EFIFO_CTRL__THRESH_bm 0x1ff00u
+#define ENC_QEI__EFIFO_CTRL__THRESH_bp 8
+#define ENC_QEI__EFIFO_CTRL__THRESH_bw 9
+#define ENC_QEI__EFIFO_CTRL__THRESH_reset 0x1u
+
+// reg - EFIFO_STATUS (per channel)
+#define ENC_QEI__EFIFO_STATUS__LEVEL_bm 0x1ffu
+#define ENC_QEI__EFIFO_STATUS__LEVEL_bp 0
+#define ENC_QEI__EFIFO_STATUS__LEVEL_bw 9
+
+// reg - EFIFO_ENTRY (per channel)
+#define ENC_QEI__EFIFO_ENTRY__VALID_bm 0x1u
+#define ENC_QEI__EFIFO_ENTRY__VALID_bp 0
+#define ENC_QEI__EFIFO_ENTRY__VALID_bw 1
+#define ENC_QEI__EFIFO_ENTRY__DIR_bm 0x2u
+#define ENC_QEI__EFIFO_ENTRY__DIR_bp 1
+#define ENC_QEI__EFIFO_ENTRY__DIR_bw 1
+#define ENC_QEI__EFIFO_ENTRY__A_bm 0x4u
+#define ENC_QEI__EFIFO_ENTRY__A_bp 2
+#define ENC_QEI__EFIFO_ENTRY__A_bw 1
+#define ENC_QEI__EFIFO_ENTRY__B_bm 0x8u
+#define ENC_QEI__EFIFO_ENTRY__B_bp 3
+#define ENC_QEI__EFIFO_ENTRY__B_bw 1
+#define ENC_QEI__EFIFO_ENTRY__LOST_bm 0x10u
+#define ENC_QEI__EFIFO_ENTRY__LOST_bp 4
+#define ENC_QEI__EFIFO_ENTRY__LOST_bw 1
+#define ENC_QEI__EFIFO_ENTRY__IDX_bm 0x20u
+#define ENC_QEI__EFIFO_ENTRY__IDX_bp 5
+#define ENC_QEI__EFIFO_ENTRY__IDX_bw 1
+#define ENC_QEI__EFIFO_ENTRY__LEFT_bm 0xff00u
+#define ENC_QEI__EFIFO_ENTRY__LEFT_bp 8
+#define ENC_QEI__EFIFO_ENTRY__LEFT_bw 8
+#define ENC_QEI__EFIFO_ENTRY__TIME_LO_bm 0xffff0000u
+#define ENC_QEI__EFIFO_ENTRY__TIME_LO_bp 16
+#define ENC_QEI__EFIFO_ENTRY__TIME_LO_bw 16
+
+// reg - EFIFO_TIME (per channel)
+#define ENC_QEI__EFIFO_TIME__VALUE_bm 0xffffffffu
+#define ENC_QEI__EFIFO_TIME__VALUE_bp 0
+#define ENC_QEI__EFIFO_TIME__VALUE_bw 32
+#define ENC_QEI__EFIFO_TIME__VALUE_reset 0x0u
+
+// reg - EFIFO_LOST (per channel)
+#define ENC_QEI__EFIFO_LOST__VALUE_bm 0xffffu
+#define ENC_QEI__EFIFO_LOST__VALUE_bp 0
+#define ENC_QEI__EFIFO_LOST__VALUE_bw 16
+#define ENC_QEI__EFIFO_LOST__VALUE_reset 0x0u
+
 // Register byte offsets in their page
 #define ENC_QEI_ID_OFFSET 0x00u
 #define ENC_QEI_CAPS_OFFSET 0x04u
@@ -474,6 +542,11 @@ extern "C" {
 #define ENC_QEI_GSNAP_PERIOD_OFFSET 0x94u
 #define ENC_QEI_GSNAP_TIME_OFFSET 0x98u
 #define ENC_QEI_IRQ_SUMMARY_OFFSET 0x9Cu
+#define ENC_QEI_EFIFO_CTRL_OFFSET 0xA0u
+#define ENC_QEI_EFIFO_STATUS_OFFSET 0xA4u
+#define ENC_QEI_EFIFO_ENTRY_OFFSET 0xA8u
+#define ENC_QEI_EFIFO_TIME_OFFSET 0xACu
+#define ENC_QEI_EFIFO_LOST_OFFSET 0xB0u
 
 // Field enumerations: ENC_QEI__<REG>__<FIELD>__<MEMBER>
 #define ENC_QEI__CAPS__PROFILE__COUNTING 1u
@@ -540,7 +613,13 @@ typedef struct {
     uint32_t PERIOD_CTRL;  /* 0x84 */
     uint32_t PERIOD;  /* 0x88 */
     uint32_t STALL_TIMEOUT;  /* 0x8C */
-    uint32_t RESERVED_90[28];
+    uint32_t RESERVED_90[4];
+    uint32_t EFIFO_CTRL;  /* 0xA0 */
+    uint32_t EFIFO_STATUS;  /* 0xA4 */
+    uint32_t EFIFO_ENTRY;  /* 0xA8 */
+    uint32_t EFIFO_TIME;  /* 0xAC */
+    uint32_t EFIFO_LOST;  /* 0xB0 */
+    uint32_t RESERVED_B4[19];
 } enc_qei_chan_t;
 typedef char enc_qei_chan_t_size_check[(sizeof(enc_qei_chan_t) == 0x100u) ? 1 : -1];
 

@@ -17,7 +17,8 @@ CASES = list(guard_cases())
 
 # limits between parameters, which a range cannot express: (module, parameters, ok, the name the
 # message must contain). enc_qei's address must reach every channel's page; a lean channel's count
-# is at least 32 bits (its free-running count is the one a driver extends).
+# is at least 32 bits (its free-running count is the one a driver extends); the edge FIFO needs the
+# timing unit (its timebase).
 RELATIONAL = [(top, params, ok, name) for top in ("enc_qei_wb", "enc_qei_axil")
               for params, ok, name in (
     ({"CHANNELS": 2, "ADDR_W": 8}, False, "ADDR_W"),
@@ -27,6 +28,8 @@ RELATIONAL = [(top, params, ok, name) for top in ("enc_qei_wb", "enc_qei_axil")
     ({"PROFILE": 3, "COUNT_W": 31}, False, "COUNT_W"),
     ({"PROFILE": 3, "COUNT_W": 32}, True, ""),
     ({"PROFILE": 3, "COUNT_W": 64, "CHANNELS": 16}, True, ""),
+    ({"PROFILE": 1, "EFIFO_LOG2": 4}, False, "EFIFO_LOG2"),
+    ({"PROFILE": 3, "EFIFO_LOG2": 8}, True, ""),
 )]
 
 

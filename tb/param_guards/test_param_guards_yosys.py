@@ -26,13 +26,16 @@ BAD: dict[str, list] = {}
 FILES: dict[str, str] = {}
 for _path, _module, _param, _value, _ok in guard_cases():
     FILES[_module] = _path
-    if not _ok:
+    # (a value below 0, EFIFO_LOG2 = -1: `hierarchy -chparam` cannot decode a negative number;
+    # the Icarus / Verilator guard tests cover it)
+    if not _ok and _value >= 0:
         BAD.setdefault(_module, []).append((_param, _value, _param.split("_", 1)[-1]
                                             if _param == "PHASE_WINDOW_LOG2" else _param))
 BAD["icebreaker_top"] += [("LINE_HZ", 0, "LINE_HZ"), ("BAUD", 12_000_000, "BAUD")]
 # enc_qei's relational limits (as in test_param_guards.RELATIONAL): parameters set together
 BAD_SETS = [(top, params, name) for top in ("enc_qei_wb", "enc_qei_axil") for params, name in (
-    ({"CHANNELS": 2, "ADDR_W": 8}, "ADDR_W"), ({"PROFILE": 3, "COUNT_W": 16}, "COUNT_W"))]
+    ({"CHANNELS": 2, "ADDR_W": 8}, "ADDR_W"), ({"PROFILE": 3, "COUNT_W": 16}, "COUNT_W"),
+    ({"PROFILE": 1, "EFIFO_LOG2": 2}, "EFIFO_LOG2"))]
 
 
 def yosys() -> str:

@@ -11,6 +11,10 @@ One entry per field, named ``<reg>_<field>`` in lower case (``ctrl_func``), with
   64-bit entry ``x`` (``preset``: bits 31:0 from X_LO, 63:32 from X_HI);
 - the event register (``intr`` fields) gives ``<reg>`` (pending bits) and ``<reg>_set`` (set
   strobes), each as wide as the register's top event bit, bits at their register positions;
+- a register of live fields with unused bits between them gives one entry ``<reg>``, the fields at
+  their register positions;
+- a live field with ``swacc`` (EFIFO_ENTRY.VALID) adds ``<reg>_rd`` (reg2hw): a one-clock strobe
+  in the clock a read of that register takes its data (the read side effect: a FIFO pop);
 - the coherent pair COUNT_LO / COUNT_HI (``coherent`` "lo" / "hi") gives ``count`` (hw2reg, the
   live count) and ``count_load`` / ``count_load_value`` (reg2hw).
 """
@@ -80,6 +84,16 @@ def pair_base(reg) -> tuple[str, int] | None:
     return None
 
 
+def gapped(reg) -> bool:
+    """A register of live fields with unused bits between them (EFIFO_ENTRY): it gives one entry
+    ``<reg>``, the fields at their register positions, so that a live bit i of the register is
+    always bit (entry + i) of hw2reg (the register proof's tables need that)."""
+    fs = [f for f in reg.fields() if field_kind(f) == "in"]
+    if len(fs) < 2 or len(fs) != len(list(reg.fields())):
+        return False
+    return sum(f.width for f in fs) != max(f.msb for f in fs) - min(f.lsb for f in fs) + 1
+
+
 def entry_name(reg, f) -> str:
     fields = list(reg.fields())
     if len(fields) == 1 and f.inst_name == "VALUE":
@@ -119,6 +133,14 @@ def build(group: str) -> Bundles:
                 b.add("h2r", f"{entry_name(reg, f)}_incr", 1, f"{desc}: count one")
                 continue
             side = "h2r" if kind == "in" else "r2h"
+            if kind == "in" and gapped(reg):
+                e = b.add("h2r", rn.lower(), max(x.msb for x in reg.fields()) + 1,
+                          f"{rn}: the live fields at their register positions (other bits unused)")
+                b.where[(rn, f.inst_name)] = ("h2r", e, f.lsb)
+            if kind == "in" and f.get_property("swacc"):
+                b.add("r2h", f"{rn.lower()}_rd", 1, f"{rn}: read (a one-clock strobe, for a read side effect)")
+            if kind == "in" and gapped(reg):
+                continue
             if pair:
                 e = b.add(side, pair[0], 64, f"{pair[0].upper()}_LO / _HI (COUNT_W bits)")
                 b.where[(rn, f.inst_name)] = (side, e, 32 * pair[1])

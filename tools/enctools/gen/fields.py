@@ -4,7 +4,8 @@ page): storage, its bundle outputs, and what a read answers.
 
 Field kinds (enctools.regmap.field_kind; anything else stops the generator with a message):
   const    sw=r  hw=na          reads its reset value
-  in       sw=r  hw=w           reads a live value from hw2reg
+  in       sw=r  hw=w           reads a live value from hw2reg; with swacc, reg2hw <reg>_rd is a
+                                one-clock strobe in the clock a read of the register takes its data
   cfg      sw=rw hw=r           storage, to reg2hw; with hwclr, hw2reg <entry>_clr clears it
                                 (a software write to its lane in the same clock wins)
   pulse    sw=w  singlepulse    a one-clock reg2hw pulse when 1 is written
@@ -92,6 +93,9 @@ class Fields:
             elif kind == "in":
                 side, e, lo = self.b.where[(rn, f.inst_name)]
                 read = self.h2r(e.name, lo, w)
+                if f.get_property("swacc"):
+                    self.emit(f"  // {rn}: a read of it is a strobe to the hardware (swacc: a read side effect)",
+                              f"  assign {self.r2h_entry(rn.lower() + '_rd')} = {self.gate(feat, self.rd(k), 1)};", "")
             elif kind == "coherent":
                 read = self.coherent(k, f, wmask)
             elif kind == "pulse":

@@ -14,7 +14,7 @@ Per register k (address order), packed vectors indexed by k:
   T_CLR     the hardware-clear bit (one at most), cleared by hw2reg[T_CLR_H2R]
   T_SET_H2R the event bits' set strobes: hw2reg[T_SET_H2R + i] for bit i
   T_SIZED   0 full, 1 COUNT_W low word, 2 COUNT_W high word, 3 TS_W
-  T_F_<U>   bits of the optional unit U (TIMING, RANGE, PROBE, PERIOD): they read 0 without it
+  T_F_<U>   bits of the optional unit U (TIMING, RANGE, PROBE, PERIOD, EFIFO): they read 0 without it
   T_CHAN    a channel register (1, in every channel's page) or a global one (0, page 0)
   T_IDX     its index in its group (the block's formal views f_view_g / f_view_ch: bits
             [32*T_IDX +: 32] of its group's view)
@@ -77,7 +77,7 @@ def rows(top=None) -> list[dict]:
         if len(sized) > 1:
             raise ValueError(f"{reg.inst_name}: fields sized differently")
         row["sized"] = SIZED[sized.pop()]
-        for n in ("TIMING", "RANGE", "PROBE", "PERIOD"):
+        for n in ("TIMING", "RANGE", "PROBE", "PERIOD", "EFIFO"):
             row[f"f_{n.lower()}"] = _mask([f for f in fs if (_udp(f, "feature") or
                                                              _udp(reg, "feature")) == n])
         row["fixed"] = _mask([f for f in fs if f.get_property("fixed_by")])
@@ -112,7 +112,7 @@ def render(top) -> str:
                              ("CLR_H2R", "clr_h2r", 16), ("SET_H2R", "set_h2r", 16),
                              ("SIZED", "sized", 2), ("F_TIMING", "f_timing", 32),
                              ("F_RANGE", "f_range", 32), ("F_PROBE", "f_probe", 32),
-                             ("F_PERIOD", "f_period", 32), ("CHAN", "chan", 1), ("IDX", "idx", 8),
+                             ("F_PERIOD", "f_period", 32), ("F_EFIFO", "f_efifo", 32), ("CHAN", "chan", 1), ("IDX", "idx", 8),
                              ("FIXED", "fixed", 32),
                              ("COH", "coh", 2)):
         lines.append(_table(name, width, [r[key] for r in rs]))

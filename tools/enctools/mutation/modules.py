@@ -77,6 +77,12 @@ MODULES: dict[str, Module] = {
                             "unit_timer_period", "unit_timer_prescaled"),
     # the multi-channel corner: the Wishbone adapter at three channels (ADDR_W 10), under
     # test_channels.py's traffic to every page
+    # the edge FIFO, at its two builds (one full channel with 16 entries on Wishbone, two lean
+    # channels with 32 on AXI4-Lite): its own feature file only
+    "enc_qei_efifo": Module("rtl/enc_qei_efifo.v", ("tb/enc_qei/test_efifo.py",),
+                            ("tb/enc_qei/test_efifo.py::*[enc_qei_wb-ch1-full-e4]",
+                             "tb/enc_qei/test_efifo.py::*[enc_qei_axil-ch2-lean-e5]"),
+                            suite=QEI_SUITE),
     "enc_qei_wb": qei("rtl/enc_qei_wb.v", (WB1, WB3), "wb_abandoned_cycle", "wb_abandoned_request",
                       "byte_enables", "isolation", "channel_map", channels=True),
     "enc_qei_axil": qei("rtl/enc_qei_axil.v", (AX1,), "concurrent_reads_and_writes",

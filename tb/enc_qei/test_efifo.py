@@ -1,0 +1,290 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The edge-capture FIFO (EFIFO_CTRL, EFIFO_STATUS, EFIFO_ENTRY, EFIFO_TIME, EFIFO_LOST and the
+EFIFO_THRESH / EFIFO_OVF events), checked against the stimulus itself.
+
+Every walk here has states lasting whole clocks and starts half a clock after a rising edge, so
+every transition falls mid-clock and the clock that samples it is known exactly: an entry's time
+must be the first entry's time plus the clocks between the two transitions (TB_PRESCALE 0), its
+direction and A/B state those of the walk's step, and the last entry's time the SNAP_EDGE_TIME of
+a snapshot taken after the walk. With the FIFO overrun, every step is either in the FIFO, in
+order, or counted in EFIFO_LOST, with LOST = 1 on the first entry after each gap: nothing is lost
+silently.
+
+Runs on EFIFO_CONFIGS: enc_qei_wb with one full channel, TS_W 32 and a 16-entry FIFO, and
+enc_qei_axil with two lean channels, TS_W 16 (TIME_LO is the whole timestamp; the timebase wraps
+in a test) and 32 entries, random AXI back-pressure, the FIFO of channel 1 (channel 0 stays
+still: its FIFO must stay empty). Every cocotb test logs its seed (make test SEED=n).
+"""
+
+from __future__ import annotations
+
+import cocotb
+import pytest
+from cocotb.triggers import ClockCycles, FallingEdge
+from hedsmodel import QUAD, walk
+
+from enctools.qei.bus import T_NS
+from enctools.qei.env import build_name, channel_envs, begin
+from enctools.qei.model import QeiModel
+from enctools.regmap import enum, event_bits, get_field, pack
+from enctools.tb import cocotb_test
+
+# (top, CHANNELS, PROFILE, COUNT_W, TS_W, EFIFO_LOG2)
+EFIFO_CONFIGS = (("enc_qei_wb", 1, "full", 32, 32, 4), ("enc_qei_axil", 2, "lean", 32, 16, 5))
+
+
+def entry_fields(word: int) -> dict:
+    return {n: get_field("EFIFO_ENTRY", n, word)
+            for n in ("VALID", "DIR", "A", "B", "LOST", "IDX", "LEFT", "TIME_LO")}
+
+
+class Fifo:
+    """One channel's FIFO as the host sees it, with the walk that feeds it."""
+
+    def __init__(self, dut, env):
+        self.dut, self.env, self.bus = dut, env, env.bus
+        self.ts_w = int(dut.TS_W.value)
+        self.depth = 1 << int(dut.EFIFO_LOG2.value)
+
+    async def pop(self) -> dict | None:
+        """One EFIFO_ENTRY read (and EFIFO_TIME when TS_W > 16): the entry, or None if empty."""
+        e = entry_fields(await self.bus.rd("EFIFO_ENTRY"))
+        if not e["VALID"]:
+            assert all(v == 0 for v in e.values()), f"an empty read answered {e}"
+            return None
+        e["TIME"] = await self.bus.rd("EFIFO_TIME") if self.ts_w > 16 else e["TIME_LO"]
+        assert e["TIME"] & 0xFFFF == e["TIME_LO"], f"TIME_LO {e['TIME_LO']:#x}, EFIFO_TIME {e['TIME']:#x}"
+        return e
+
+    async def drain(self) -> list[dict]:
+        out = []
+        while (e := await self.pop()) is not None:
+            out.append(e)
+        return out
+
+    async def start(self, func="x4", thresh=1):
+        model = QeiModel(self.env.count_w)
+        await self.env.setup(model, func=func)
+        await self.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=thresh))
+        await self.bus.wr("EFIFO_LOST", 0)
+        await self.bus.events()
+        return model
+
+    def walk(self, rng, n: int, lo: int, hi: int, p_rev: float = 0.3):
+        """n steps, each state lasting lo .. hi whole clocks; returns the waveform and the list
+        of (clock offset from the first step, +1/-1, (A, B) after it, position after it)."""
+        steps, clocks, pos, out, t = [], [], self.env.pos, [], 0
+        direction = 1
+        for i in range(n):
+            if rng.random() < p_rev:
+                direction = -direction
+            c = rng.randint(lo, hi)
+            steps.append(direction)
+            clocks.append(c)
+        wf = walk(steps, [c * T_NS for c in clocks], start_pos=pos)
+        for k, (s, c) in enumerate(zip(steps, clocks)):
+            t += c if k else 0
+            pos += s
+            out.append((t, s, QUAD[pos % 4], pos))
+        return wf, out
+
+    async def play(self, wf):
+        await FallingEdge(self.dut.clk)  # transitions mid-clock (states of whole clocks)
+        await self.env.drv.play(wf)
+        self.env.pos = wf.positions[-1]
+
+
+def match(entries: list[dict], steps: list, ts_w: int, lost_count: int, what: str) -> None:
+    """The entries against the walk's steps: each entry is the step whose clock offset its time
+    gives (the first entry is the first step), in order, with its direction and state; a gap
+    before an entry iff it has LOST; the steps missing = lost_count."""
+    mask = (1 << ts_w) - 1
+    assert entries, f"{what}: no entries"
+    by_offset = {t: i for i, (t, _, _, _) in enumerate(steps)}
+    t0, prev, missing = entries[0]["TIME"], -1, 0
+    for n, e in enumerate(entries):
+        off = (e["TIME"] - t0) & mask
+        assert off in by_offset, f"{what}: entry {n} at +{off} clocks matches no step"
+        i = by_offset[off]
+        _, s, (a, b), _ = steps[i]
+        assert i > prev, f"{what}: entry {n} (step {i}) out of order after step {prev}"
+        assert (e["DIR"], e["A"], e["B"]) == (int(s > 0), a, b), \
+            f"{what}: entry {n} = step {i}: DIR/A/B {e['DIR']}{e['A']}{e['B']}, step {s:+d} to {a}{b}"
+        gap = i - prev - 1 if n else 0
+        assert e["LOST"] == int(gap > 0), f"{what}: entry {n} (step {i}) LOST {e['LOST']}, gap {gap}"
+        missing += gap
+        prev = i
+    missing += len(steps) - 1 - prev
+    assert missing == lost_count, f"{what}: {missing} steps missing, EFIFO_LOST {lost_count}"
+
+
+async def fifo_of(dut):
+    envs, rng = await _start(dut)
+    env = envs[-1]  # the last channel (channel 1 of the two-channel build)
+    return Fifo(dut, env), envs, rng
+
+
+async def _start(dut):
+    _, rng = await begin(dut)
+    return channel_envs(dut, rng, int(dut.CHANNELS.value)), rng
+
+
+@cocotb_test()
+async def entries_match_the_walk(dut):
+    """A random walk (reversals at any state) read back in full: every step in order with its
+    direction, A/B state and clock-exact time; the last entry's time is SNAP_EDGE_TIME; CAPS says
+    the depth; the other channel's FIFO stays empty."""
+    fifo, envs, rng = await fifo_of(dut)
+    assert get_field("CAPS", "EFIFO_LOG2", await fifo.bus.rd("CAPS")) == int(dut.EFIFO_LOG2.value)
+    await fifo.start()
+    for rnd in range(3):
+        if rnd == 1 and fifo.ts_w == 16:  # let the timebase wrap inside this round's walk
+            tb = await fifo.bus.rd("TIMEBASE")
+            await ClockCycles(dut.clk, ((1 << 16) - tb - 200) % (1 << 16) + 1)
+        wf, steps = fifo.walk(rng, fifo.depth - 1, 3, 40)
+        await fifo.play(wf)
+        await ClockCycles(dut.clk, 12)
+        assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == len(steps)
+        await fifo.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        edge_time = await fifo.bus.rd("SNAP_EDGE_TIME")
+        entries = await fifo.drain()
+        assert [e["LEFT"] for e in entries] == list(range(len(steps) - 1, -1, -1))
+        match(entries, steps, fifo.ts_w, 0, f"round {rnd}")
+        assert entries[-1]["TIME"] == edge_time, \
+            f"last entry at {entries[-1]['TIME']:#x}, SNAP_EDGE_TIME {edge_time:#x}"
+        assert await fifo.bus.rd("EFIFO_LOST") == 0
+    if len(envs) > 1:
+        assert get_field("EFIFO_STATUS", "LEVEL", await envs[0].bus.rd("EFIFO_STATUS")) == 0
+        assert await envs[0].bus.rd("EFIFO_ENTRY") == 0
+
+
+@cocotb_test()
+async def overrun_is_never_silent(dut):
+    """Twice the depth of steps with no reads: LEVEL is the depth, EFIFO_LOST counts the rest,
+    EFIFO_OVF is raised, the entries are the first steps; after draining, the next entry has
+    LOST = 1 and the one after it LOST = 0."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    n = 2 * fifo.depth + 3
+    wf, steps = fifo.walk(rng, n, 3, 8)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == fifo.depth
+    lost = await fifo.bus.rd("EFIFO_LOST")
+    assert lost == n - fifo.depth, f"EFIFO_LOST {lost}, expected {n - fifo.depth}"
+    assert "EFIFO_OVF" in await fifo.bus.events()
+    entries = await fifo.drain()
+    assert len(entries) == fifo.depth and not any(e["LOST"] for e in entries)
+    match(entries, steps[:fifo.depth], fifo.ts_w, 0, "the stored steps")
+    wf, more = fifo.walk(rng, 2, 5, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    after = await fifo.drain()
+    assert [e["LOST"] for e in after] == [1, 0], f"LOST after the gap: {[e['LOST'] for e in after]}"
+    await fifo.bus.wr("EFIFO_LOST", 0)
+    assert await fifo.bus.rd("EFIFO_LOST") == 0
+
+
+@cocotb_test()
+async def drained_while_counting_at_the_bound(dut):
+    """Steps every 2 .. 4 clocks (the count-rate bound at FILTER_LEN 2) while the host drains
+    the FIFO as fast as the bus allows (pops and pushes in the same clocks, the FIFO full at
+    times): every step is an entry in order or is counted in EFIFO_LOST, and LOST marks every
+    gap."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    wf, steps = fifo.walk(rng, 6 * fifo.depth, 2, 4, p_rev=0.1)
+    entries: list[dict] = []
+    player = cocotb.start_soon(fifo.play(wf))
+    while not player.done():
+        if (e := await fifo.pop()) is not None:
+            entries.append(e)
+    await ClockCycles(dut.clk, 12)
+    entries += await fifo.drain()
+    lost = await fifo.bus.rd("EFIFO_LOST")
+    dut._log.info("%d steps: %d entries, %d lost", len(steps), len(entries), lost)
+    match(entries, steps, fifo.ts_w, lost, "drained at the bound")
+    assert len(entries) + lost == len(steps)
+
+
+@cocotb_test()
+async def threshold_event_and_irq(dut):
+    """EFIFO_THRESH is set while LEVEL >= THRESH (a clear does not stick until the FIFO is drained
+    below it) and drives irq when enabled; EN = 0 stores nothing; CLEAR empties the FIFO; an
+    empty read pops nothing and leaves EFIFO_TIME alone."""
+    fifo, _, rng = await fifo_of(dut)
+    thresh = rng.randint(2, fifo.depth - 2)
+    await fifo.start(thresh=thresh)
+    await fifo.bus.wr("IRQ_EN", event_bits("EFIFO_THRESH"))
+    wf, _ = fifo.walk(rng, thresh - 1, 3, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False)
+    assert dut.irq.value == 0
+    wf, _ = fifo.walk(rng, 1, 3, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert "EFIFO_THRESH" in await fifo.bus.events()  # (cleared, set again)
+    assert "EFIFO_THRESH" in await fifo.bus.events(clear=False), "cleared above THRESH"
+    assert dut.irq.value == 1
+    e = await fifo.pop()
+    time = e["TIME"]
+    await fifo.bus.events()
+    assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False)
+    await ClockCycles(dut.clk, 3)
+    assert dut.irq.value == 0
+    # EN = 0: no pushes; CLEAR: empty; an empty read pops nothing
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=0, THRESH=thresh))
+    wf, _ = fifo.walk(rng, 3, 3, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == thresh - 1
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=0, CLEAR=1, THRESH=thresh))
+    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == 0
+    assert await fifo.bus.rd("EFIFO_ENTRY") == 0
+    assert await fifo.bus.rd("EFIFO_TIME") == time
+
+
+@cocotb_test()
+async def index_marks_its_entry(dut):
+    """An index pulse over a few positions (INDEX_CTRL EDGE rising, no gate): the entry of the
+    step into the pulse, either way, has IDX = 1, every other entry IDX = 0; an index while
+    EN = 0 marks nothing."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    await fifo.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
+    period = rng.choice((12, 16, 20))
+
+    def zf(p, n=period):
+        return int(5 <= p % n <= 7)
+    wf, steps = fifo.walk(rng, fifo.depth - 1, 4, 12, p_rev=0.3)
+    index = [(t, zf(p)) for (t, _, _), p in zip(wf.events, wf.positions)]
+    await FallingEdge(dut.clk)
+    await fifo.env.drv.play(wf, index=index)
+    fifo.env.pos = wf.positions[-1]
+    await ClockCycles(dut.clk, 12)
+    entries = await fifo.drain()
+    match(entries, steps, fifo.ts_w, 0, "index walk")
+    # Z was 0: a walk starting inside the pulse raises it with no step, which marks the first entry
+    prev_z = zf(wf.positions[0])
+    pending = prev_z
+    expect = []
+    for _, _, _, pos in steps:
+        z = zf(pos)
+        expect.append(int(bool(z and not prev_z) or bool(pending)))
+        prev_z, pending = z, 0
+    assert [e["IDX"] for e in entries] == expect, \
+        f"IDX {[e['IDX'] for e in entries]}, index rising at {expect}"
+    dut._log.info("%d entries, %d with IDX", len(entries), sum(expect))
+
+
+# ---- pytest --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,channels,profile,count_w,ts_w,efifo_log2", EFIFO_CONFIGS,
+                         ids=[f"{t}-ch{c}-{p}-e{e}" for t, c, p, _, _, e in EFIFO_CONFIGS])
+def test_efifo(top, channels, profile, count_w, ts_w, efifo_log2):
+    from enctools.harness import run
+
+    code = enum("CAPS", "PROFILE")[profile]
+    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}_e{efifo_log2}",
+        parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code,
+                    "EFIFO_LOG2": efifo_log2})
