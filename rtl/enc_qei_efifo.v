@@ -172,6 +172,77 @@ module enc_qei_efifo #(
   assign ev_ovf    = lose;
   assign lost_incr = lose;
 
+`ifdef FORMAL
+  // ---- properties (formal/enc_qei_efifo.sby, with formal/enc_qei_efifo_formal.v driving the
+  // ports and checking the port contract; these need the storage) -----------------------------
+  // Data integrity: a stored entry the solver picks (f_pick, any clock) is what the head holds,
+  // and what a read returns, when the pops reach it; the entries before it pop first.
+  (* anyseq *) reg f_pick;
+  reg                  f_past_valid = 1'b0;
+  reg                  f_track;   // the picked entry is in the FIFO
+  reg [DEPTH_LOG2-1:0] f_addr;    // ... at this address
+  reg [W-1:0]          f_data;    // ... with this content
+  reg                  f_lost;    // a step was lost since the last entry stored (restated)
+  wire [DEPTH_LOG2-1:0] f_ahead = f_addr - rd_ptr_q;  // entries ahead of it
+
+  always @(posedge clk) begin
+    f_past_valid <= 1'b1;
+    if (rst | clear) begin
+      f_track <= 1'b0;
+    end else if (f_track & pop_ok & (rd_ptr_q == f_addr)) begin
+      f_track <= 1'b0;
+    end else if (~f_track & store & f_pick) begin
+      f_track <= 1'b1;
+      f_addr  <= wr_ptr_q;
+      f_data  <= wdata;
+    end
+    if (rst | clear | store) begin
+      f_lost <= 1'b0;
+    end else if (lose) begin
+      f_lost <= 1'b1;
+    end
+  end
+
+  always @(*) begin
+    if (f_past_valid && !rst) begin
+      // the level is what the pointers say (and never more than the depth)
+      assert (level_q <= LVL_FULL);
+      assert (level_q[DEPTH_LOG2-1:0] == wr_ptr_q - rd_ptr_q);
+      // the head holds the oldest entry
+      if (nonempty) assert (head_q == mem[rd_ptr_q]);
+      // every step is stored or lost, never both (a clear drops it by design)
+      assert (!(store && lose));
+      if (push_q && !clear) assert (store || lose);
+      // the LOST mark is set exactly by a loss since the last entry stored
+      assert (lost_pend_q == f_lost);
+      // the picked entry: stored unchanged, within the level, returned when it is the head
+      if (f_track) begin
+        assert (f_ahead < level_q);
+        assert (mem[f_addr] == f_data);
+        if (rd_ptr_q == f_addr) assert (head_q == f_data);
+        if (pop_ok && rd_ptr_q == f_addr) begin
+          assert (entry[31:16] == f_data[20:5]);
+          assert (entry[5:1] == {f_data[4:1], f_data[0]});
+        end
+      end
+    end
+  end
+
+  always @(posedge clk) begin
+    if (f_past_valid && !rst && !$past(rst)) begin
+      // EFIFO_TIME: the time of the entry the last pop took
+      if ($past(pop_ok)) assert (pop_time_q == $past(head_q[W-1:5]));
+      if (!$past(pop_ok)) assert (pop_time_q == $past(pop_time_q));
+    end
+  end
+
+  always @(*) begin
+    cover (f_track && pop_ok && rd_ptr_q == f_addr && level_q == LVL_FULL);  // a full FIFO drained to it
+    cover (lose && pop == 1'b0);
+    cover (store && pop_ok && full);  // a push and a pop in the same clock, the FIFO full
+  end
+`endif
+
 endmodule
 
 `default_nettype wire
