@@ -29,7 +29,9 @@ Modules: :mod:`.note` (the note's numbers), :mod:`.budget` (its error-budget alg
 ``scripts/error_budget.py``), :mod:`.profile`, :mod:`.unit` (the physics, described there),
 :mod:`.measurement`, :mod:`.montecarlo` (Figure 7 batch, used by ``scripts/monte_carlo.py``),
 :mod:`.velocity` (host-side M, T and M/T velocity estimators for enc_qei snapshots, mirrored in C
-by ``sw/enc_qei_velocity.c``, and the snapshots an ideal peripheral latches from a waveform).
+by ``sw/enc_qei_velocity.c``, the snapshots an ideal peripheral latches from a waveform, and
+the entries of enc_qei's edge FIFO: ``EdgeEntry``, ``ideal_edge_entries``), :mod:`.calibration`
+(a self-calibrating estimator fed by those entries, mirrored by ``sw/enc_qei_calib.c``).
 Waveforms: :mod:`.waveform` (``Waveform``, ``walk``, ``random_walk``, ``with_glitches``, ``QUAD``,
 ``STATE_TO_POS``, ``state_of``) -- the event-list format every generator here produces and the
 cocotb driver in :mod:`cocotbext.quadrature` plays. Nothing in this package imports cocotb.

@@ -444,3 +444,82 @@ def estimate(snaps, cfg: EstimatorConfig, cpr: int = 500) -> dict:
     est = VelocityEstimator(cfg)
     rd = est.run(snaps)
     return {meth: np.array([to_rpm(r.get(meth), cpr) for r in rd]) for meth in METHODS}
+
+
+# ------------------------------------------------------------------ ideal edge-capture FIFO
+
+@dataclass(frozen=True)
+class EdgeEntry:
+    """One entry of enc_qei's edge-capture FIFO: ``time`` (TIMEBASE at the step, TS_W bits,
+    the same stamp as SNAP_EDGE_TIME for an any-edge), ``a``/``b`` (the A/B state after the
+    step), ``up`` (True: +1 step, False: -1), ``lost`` (one or more entries were lost to a full
+    FIFO between the previous entry and this one), ``idx`` (a qualified index edge came since the
+    previous entry, up to this entry's step)."""
+
+    time: int
+    a: int
+    b: int
+    up: bool
+    lost: bool = False
+    idx: bool = False
+
+
+def ideal_edge_entries(wf, timebase: Timebase, t0_s: float = 0.0, t_end_s: float | None = None,
+                       index=None) -> list:
+    """The :class:`EdgeEntry` list an ideal enc_qei edge FIFO (x4 count function, never full)
+    pushes for the model waveform ``wf``.
+
+    ``wf`` is a :class:`hedsmodel.waveform.Waveform`, or the ``(wf, index)`` pair that
+    ``EncoderUnit.waveform(profile, index=True)`` returns; ``index`` (``[(t_ns, level)]``, its
+    first entry the level at t = 0) may also be given on its own. Exactly:
+
+    - the steps are those of :func:`edge_table` (a model event where both channels change in the
+      same picosecond has no position of its own and is merged into the next known one); each
+      step of ``n`` counts (``|n| > 1`` only after such a merge) pushes ``|n|`` entries with the
+      same time, one per count, each with the A/B state after its count (``QUAD[pos % 4]`` of
+      the absolute 4X position). The RTL's x4 decoder would treat a double change as an illegal
+      transition instead: walks compared with the RTL should not contain one;
+    - only steps at pin times ``t0_s <= t <= t_end_s`` (``t_end_s=None``: all) are pushed;
+    - ``time`` = ``timebase.ticks(timebase.clock_of(t) + latency_clocks)`` modulo 2^TS_W: the
+      first clock edge at or after the pin time, plus the pipeline latency, through the
+      prescaler (TIMEBASE = (clock + tb_offset) // (prescale + 1)), wrapped at ``ts_w`` bits;
+    - ``up`` = the step is +1; ``lost`` is always False (the ideal FIFO is never full);
+    - ``idx`` is set on the first entry whose step's pin time is at or after a rising edge of the
+      model's index (Z) level (a rise with no step after it sets nothing; the level at t = 0 is
+      not a rise). With the model's gated index (high exactly in state 0 of each revolution)
+      that is the step into a 4X position that is a multiple of 4N, in either direction; its
+      state is (0, 0).
+    """
+    return edge_entries_with_ticks(wf, timebase, t0_s, t_end_s, index)[0]
+
+
+def edge_entries_with_ticks(wf, timebase: Timebase, t0_s: float = 0.0,
+                            t_end_s: float | None = None, index=None):
+    """:func:`ideal_edge_entries` and, per entry, its TIMEBASE unwrapped (numpy int64), to merge
+    the entries with reads in time order."""
+    from .waveform import QUAD
+
+    if isinstance(wf, tuple):
+        wf, index = wf
+    et = edge_table(wf)
+    start = wf.positions[0] if wf.positions[0] is not None else 0
+    rises = []
+    if index:
+        rises = [t * 1e-9 for (t, lv), (_, lv0) in zip(index[1:], index[:-1]) if lv and not lv0]
+    ticks = timebase.ticks(timebase.clock_of(et.t_s) + timebase.latency_clocks)
+    mask = (1 << timebase.ts_w) - 1
+    out, unwrapped, ri = [], [], 0
+    hi = math.inf if t_end_s is None else t_end_s
+    for t, n, p, tk in zip(et.t_s.tolist(), et.step.tolist(), et.pos.tolist(), ticks.tolist()):
+        flag = False
+        while ri < len(rises) and rises[ri] <= t:
+            ri += 1
+            flag = True
+        if not t0_s <= t <= hi:
+            continue
+        up = n > 0
+        for k in range(abs(n)):
+            a, b = QUAD[(start + p - (abs(n) - 1 - k) * (1 if up else -1)) % 4]
+            out.append(EdgeEntry(int(tk) & mask, a, b, up, False, flag and k == 0))
+            unwrapped.append(int(tk))
+    return out, np.array(unwrapped, np.int64)
