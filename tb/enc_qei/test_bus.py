@@ -19,7 +19,7 @@ from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations
-from enctools.regmap import addr, event_bits, regmap, size_mask
+from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
 from enctools.tb import cocotb_test
 
 
@@ -130,9 +130,10 @@ async def register_walk(dut):
     count_w, ts_w = caps & 0xFF, caps >> 8 & 0xFF
     assert (count_w, ts_w) == (env.count_w, int(dut.TS_W.value)), f"CAPS {caps:#x}"
     regs = sorted(regmap().values(), key=lambda r: r.offset)
+    have = units(caps)
 
     def fmask(f):
-        return (size_mask(f.sized_by, count_w, ts_w) << f.lsb) & f.mask
+        return built_mask(f, count_w, ts_w, have)
 
     # 1. reset values (the encoder is still): every field that has one
     for r in regs:
@@ -183,10 +184,9 @@ def _cfg_regs():
             if not r.coherent and r.name != "EVENTS" and any(f.kind == "cfg" for f in r.fields.values())]
 
 
-def _cfg_mask(r, count_w, ts_w):
-    """The storage bits at this COUNT_W / TS_W (the bits a write sets)."""
-    return sum((size_mask(f.sized_by, count_w, ts_w) << f.lsb) & f.mask
-               for f in r.fields.values() if f.kind == "cfg")
+def _cfg_mask(r, count_w, ts_w, have):
+    """The storage bits at this COUNT_W / TS_W with these units (the bits a write sets)."""
+    return sum(built_mask(f, count_w, ts_w, have) for f in r.fields.values() if f.kind == "cfg")
 
 
 def _cfg_fields(r):
@@ -202,13 +202,14 @@ async def register_patterns(dut):
     env, rng = await begin(dut)
     bus = env.bus
     count_w, ts_w = env.count_w, int(dut.TS_W.value)
+    have = units(await bus.rd("CAPS"))
     regs = _cfg_regs()
     for flip in (0, 0xFFFFFFFF):
         want = {}
         for i, r in enumerate(regs):
             value = ((0x9E3779B9 * (i + 1)) & 0xFFFFFFFF) ^ flip
             await bus.wr(r.name, value)
-            want[r.name] = value & _cfg_mask(r, count_w, ts_w)
+            want[r.name] = value & _cfg_mask(r, count_w, ts_w, have)
         for r in regs:
             m = _cfg_fields(r)
             for gap in (1, 2, 0):
@@ -230,8 +231,9 @@ async def byte_enables_all(dut):
     bus = env.bus
     count_w, ts_w = env.count_w, int(dut.TS_W.value)
     masks = [1, 2, 4, 8, 3, 6, 12, 7, 14] + ([5, 9, 10, 13, 11] if bus.kind == "wb" else [])
+    have = units(await bus.rd("CAPS"))
     for i, r in enumerate(_cfg_regs()):
-        m, fm = _cfg_mask(r, count_w, ts_w), _cfg_fields(r)
+        m, fm = _cfg_mask(r, count_w, ts_w, have), _cfg_fields(r)
         for k, (strb, flip) in enumerate((m, f) for m in masks for f in (0, 0xFFFFFFFF)):
             lanes = sum(0xFF << 8 * j for j in range(4) if strb >> j & 1)
             old = ((0xC3A55A3C * (i + 3 * k + 1)) ^ flip) & 0xFFFFFFFF  # each bit kept as 0 and as 1
@@ -286,7 +288,7 @@ async def concurrent_reads_and_writes(dut):
             got = [await bus.rd(n) for n in ("ID", "CAPS", "ID", "CAPS")]
         assert got == [ident, caps, ident, caps], f"round {rnd}: reads {got}"
         for r, v in values.items():
-            m = _cfg_mask(regmap()[r], env.count_w, int(dut.TS_W.value))
+            m = _cfg_mask(regmap()[r], env.count_w, int(dut.TS_W.value), units(caps))
             assert await bus.rd(r) == v & m, f"round {rnd}: {r}"
     for r in ("PRESET_LO", "COMPARE_LO", "IRQ_EN", "SNAP_PERIOD"):
         await bus.wr(r, 0)

@@ -16,7 +16,7 @@ from hedsmodel import QUAD, random_walk, walk
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, pulse_rst
-from enctools.regmap import pack, regmap
+from enctools.regmap import built_mask, pack, regmap, units
 from enctools.tb import cocotb_test
 
 
@@ -40,6 +40,7 @@ async def reset_mid_motion(dut):
     await task
     env.pos = wf.positions[-1]
     await env.settle(20)
+    have = units(await bus.rd("CAPS"))
     for name, reg in regmap().items():
         if reg.coherent or name in ("TIMEBASE", "STATUS", "EVENTS", "GLITCH_COUNT", "QERR_COUNT"):
             continue
@@ -50,9 +51,8 @@ async def reset_mid_motion(dut):
         got = await bus.rd(name)
         mask = 0
         for f in reg.fields.values():
-            from enctools.regmap import size_mask
-            mask |= (size_mask(f.sized_by, env.count_w, int(dut.TS_W.value)) << f.lsb) & f.mask \
-                if f.reset is not None else 0
+            if f.reset is not None:
+                mask |= built_mask(f, env.count_w, int(dut.TS_W.value), have)
         assert got & mask == exp & mask, f"{name} after rst: {got:#x}, reset {exp & mask:#x}"
     # counting resumes from the reference taken after rst
     model2 = QeiModel(env.count_w)

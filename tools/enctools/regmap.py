@@ -71,7 +71,7 @@ class Field:
     sized_by: str | None
     enum: dict | None  # member name -> value
     kind: str
-    feature: str | None = None  # the optional unit the field belongs to (reads 0 without it)
+    feature: str | None = None  # the optional unit of the field or its register (reads 0 without it)
 
     @property
     def mask(self) -> int:
@@ -172,7 +172,7 @@ def _compile_regmap(path: Path) -> dict[str, Reg]:
                 f.inst_name, f.lsb, f.width, f.get_property("sw").name, f.get_property("hw").name,
                 f.get_property("reset"), f.get_property("sized_by"),
                 {m.name: m.value for m in enc} if enc is not None else None, field_kind(f),
-                _udp(f, "feature"))
+                _udp(f, "feature") or _feature(r))
         regs[r.inst_name] = Reg(r.inst_name, offset, _feature(r), fields, group)
     return regs
 
@@ -228,6 +228,27 @@ def event_names(word: int) -> set[str]:
 
 def event_bits(*names: str) -> int:
     return sum(regmap()["EVENTS"].fields[n].mask for n in names)
+
+
+def units(caps: int) -> set[str]:
+    """The optional units (the RDL's ``feature`` names) a build has, from its CAPS word."""
+    profile = {v: k for k, v in enum("CAPS", "PROFILE").items()}.get(get_field("CAPS", "PROFILE", caps))
+    out = {"RANGE", "PROBE"} if profile in ("full", "counting") else set()
+    if get_field("CAPS", "TIMING", caps):
+        out.add("TIMING")
+    if profile == "full":
+        out.add("PERIOD")
+    if get_field("CAPS", "EFIFO_LOG2", caps):
+        out.add("EFIFO")
+    return out
+
+
+def built_mask(f: Field, count_w: int, ts_w: int, have: set[str]) -> int:
+    """The bits of field ``f`` a build holds: its size (size_mask) if its unit is in ``have``
+    (units(CAPS)), else none (a field of a unit left out reads 0)."""
+    if f.feature is not None and f.feature not in have:
+        return 0
+    return (size_mask(f.sized_by, count_w, ts_w) << f.lsb) & f.mask
 
 
 def size_mask(sized_by: str | None, count_w: int, ts_w: int) -> int:
