@@ -3,7 +3,7 @@
 """FPGA synthesis of every contract block, of the iCEBreaker board top and of enc_qei at 1 to 16
 channels (`make synth`).
 
-The command line of enctools.synth (tools/enctools/synth.py); --help lists its options."""
+The command line of enctools.synth (tools/enctools/synth/cli.py); --help lists its options."""
 
 import sys
 
