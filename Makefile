@@ -63,7 +63,7 @@ sweep: $(STAMP) ## dense model-driven count-limit sweep (FILTER_LEN 1..4 x phase
 lint: $(STAMP) ## verilator --lint-only -Wall and iverilog -Wall on every module in rtl/
 	@bash scripts/lint.sh
 
-synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K; enc_qei also ECP5) and the iCEBreaker top; table in doc/results/synth_results.md (QUICK=1: one seed, no table)
+synth: $(STAMP) ## Yosys + nextpnr: every block (HX8K; enc_qei also ECP5) and the iCEBreaker top; tables in doc/results/synth_results.md and doc/results/synth_channels.md (QUICK=1: one seed, no table)
 	$(PY) scripts/synth.py --jobs $(JOBS) $(if $(filter 1,$(QUICK)),--quick)
 
 bitstream: $(STAMP) ## iCEBreaker bitstream: build/icebreaker/icebreaker_top.bin
