@@ -106,3 +106,36 @@ def test_sim_analysis_on_ideal_registers():
     print("\n".join(rep["lines"] + rep["goals"]))
     assert rep["goals"] and all(g.startswith(("MET", "INFO")) for g in rep["goals"]), rep["goals"]
     assert len(rep["points"]) == 6
+
+
+def test_calibrated_rows_quick(tmp_path):
+    """The calibrated methods' part of the bench (enctools.velocity.calib), --quick, one
+    non-ideal unit: calibrated M/T A↑ far below the uncalibrated one, the goal lines written."""
+    from enctools.velocity import calib, calib_report
+
+    args = argparse.Namespace(quick=True, seed=5, units=1, jobs=1, stall_ms=200.0, prescale=0,
+                              clk_mhz=100.0, rpm_min=1.0, rpm_max=12000.0, points=12)
+    print("seed 5")
+    units = plan.make_units(args)
+    res = calib.run_calibration(args, units)
+    goals = calib_report.write_calibration(args, units, res, tmp_path / "cal.md",
+                                           tmp_path / "cal.png", res["wall_s"])
+    print("\n".join(goals))
+    rows = [r for r in res["constant"] if r["unit"] != "ideal"]
+    assert len(rows) == 3
+    for r in rows:
+        assert r["random"]["A cal"] < 5e-4 and r["random"]["A cal"] < r["random"]["A uncal"] / 10
+        assert r["none"]["any cal"] < 1e-3 < r["none"]["any uncal"]
+    assert goals[0].startswith("MET") and any("wheel changed" in g for g in goals)
+    text = (tmp_path / "cal.md").read_text()
+    assert "## Error against revolutions of learning" in text and (tmp_path / "cal.png").exists()
+
+
+def test_calibration_table_is_current():
+    """doc/results/velocity_calibration.md names the code it was made with: rerun
+    `make velocity` (or scripts/velocity_bench.py --calib only) when that code changes."""
+    from enctools.velocity.calib_report import SOURCES, TABLE, source_hash
+
+    text = TABLE.read_text()
+    assert f"<!-- source {source_hash()} -->" in text, \
+        f"{TABLE.relative_to(TOP)} is stale: {', '.join(SOURCES)} changed since it was written"

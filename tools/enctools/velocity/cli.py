@@ -63,6 +63,9 @@ def _parser() -> Parser:
                    help="TB_PRESCALE.PRESCALE: timebase tick = (P+1) clocks (default 0)")
     p.add_argument("--clk-mhz", type=_num(float, 1, 1000), default=100.0,
                    help="peripheral clock, MHz (default 100)")
+    p.add_argument("--calib", choices=("on", "off", "only"), default="on",
+                   help="the calibrated methods (doc/results/velocity_calibration.md): after the "
+                        "rest (on), not at all (off), or alone (only)")
     p.add_argument("--stall-ms", type=_num(float, 0, 10000, lo_open=True), default=200.0,
                    help="stall timeout of the estimators, ms (default 200)")
     return p
@@ -99,6 +102,8 @@ def main(argv=None) -> int:
         s = usum[n]
         print(f"unit {n}: state-width error {s['state_error_deg']:.1f} e°, phase "
               f"{s['phase_error_deg']:.1f} e°, eccentricity {s['ecc_mm']:.4f} mm TIR", flush=True)
+    if args.calib == "only":
+        return _calibration(args, units)
     model = run_model(args, units)
     print(f"model layer: {model['wall_s']:.1f} s", flush=True)
     sim = None
@@ -115,4 +120,18 @@ def main(argv=None) -> int:
     print(f"wrote {TABLE.relative_to(TOP)} and {FIGURE.relative_to(TOP)} in {wall / 60:.1f} min")
     for v in verdicts:
         print("  " + v)
+    return _calibration(args, units) if args.calib == "on" else 0
+
+
+def _calibration(args, units) -> int:
+    """The calibrated methods (enctools.velocity.calib), their table and plot."""
+    from .calib import run_calibration
+    from .calib_report import FIGURE as CFIG, TABLE as CTAB, write_calibration
+
+    res = run_calibration(args, units)
+    goals = write_calibration(args, units, res, CTAB, CFIG, res["wall_s"])
+    print(f"wrote {CTAB.relative_to(TOP)} and {CFIG.relative_to(TOP)} in "
+          f"{res['wall_s'] / 60:.1f} min")
+    for g in goals:
+        print("  " + g)
     return 0
