@@ -90,7 +90,9 @@ module enc_qei_efifo #(
   wire lose     = push_q & ~clear & full & ~pop_ok;
   wire idx_now  = idx_q | idx_pend_q;
 
-  wire [DEPTH_LOG2-1:0] rd_ptr_d = clear ? {DEPTH_LOG2{1'b0}} : (pop_ok ? rd_ptr_q + PTR_ONE : rd_ptr_q);
+  // the read address of the head register: the next entry in a clock that pops (in the clock of
+  // a clear it does not matter: the FIFO is empty after it, and the next store bypasses memory)
+  wire [DEPTH_LOG2-1:0] rd_ptr_d = pop_ok ? rd_ptr_q + PTR_ONE : rd_ptr_q;
 
   always @(posedge clk) begin
     if (rst) begin

@@ -52,7 +52,7 @@ class Fifo:
         if not e["VALID"]:
             assert all(v == 0 for v in e.values()), f"an empty read answered {e}"
             return None
-        e["TIME"] = await self.bus.rd("EFIFO_TIME") if self.ts_w > 16 else e["TIME_LO"]
+        e["TIME"] = await self.bus.rd("EFIFO_TIME")  # (with TS_W 16: the same as TIME_LO)
         assert e["TIME"] & 0xFFFF == e["TIME_LO"], f"TIME_LO {e['TIME_LO']:#x}, EFIFO_TIME {e['TIME']:#x}"
         return e
 
@@ -60,6 +60,9 @@ class Fifo:
         out = []
         while (e := await self.pop()) is not None:
             out.append(e)
+        if out:  # EFIFO_TIME holds the last pop's time (the empty read above popped nothing)
+            held = await self.bus.rd("EFIFO_TIME")
+            assert held == out[-1]["TIME"], f"EFIFO_TIME {held:#x} after the drain, last {out[-1]['TIME']:#x}"
         return out
 
     async def start(self, func="x4", thresh=1):
@@ -210,10 +213,16 @@ async def drained_while_counting_at_the_bound(dut):
 @cocotb_test()
 async def threshold_event_and_irq(dut):
     """EFIFO_THRESH is set while LEVEL >= THRESH (a clear does not stick until the FIFO is drained
-    below it) and drives irq when enabled; EN = 0 stores nothing; CLEAR empties the FIFO; an
+    below it; THRESH 0 acts as 1) and drives irq when enabled; EN = 0 stores nothing; CLEAR empties the FIFO; an
     empty read pops nothing and leaves EFIFO_TIME alone."""
     fifo, _, rng = await fifo_of(dut)
-    thresh = rng.randint(2, fifo.depth - 2)
+    thresh = 2 * rng.randint(1, fifo.depth // 2 - 1)  # even: a THRESH off by one in bit 0 shows
+    # THRESH 0 acts as 1: one entry sets the event
+    await fifo.start(thresh=0)
+    wf, _ = fifo.walk(rng, 1, 3, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert "EFIFO_THRESH" in await fifo.bus.events(), "THRESH 0 with one entry"
     await fifo.start(thresh=thresh)
     await fifo.bus.wr("IRQ_EN", event_bits("EFIFO_THRESH"))
     wf, _ = fifo.walk(rng, thresh - 1, 3, 9)
