@@ -21,7 +21,9 @@ from __future__ import annotations
 import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, FallingEdge
-from hedsmodel import QUAD, walk
+import numpy as np
+from hedsmodel import QUAD, EncoderUnit, Profile, walk
+from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
 
 from enctools.qei.bus import T_NS
 from enctools.qei.env import build_name, channel_envs, begin
@@ -285,6 +287,47 @@ async def index_marks_its_entry(dut):
     assert [e["IDX"] for e in entries] == expect, \
         f"IDX {[e['IDX'] for e in entries]}, index rising at {expect}"
     dut._log.info("%d entries, %d with IDX", len(entries), sum(expect))
+
+
+@cocotb_test()
+async def model_unit_matches_ideal_entries(dut):
+    """A modelled HEDS-5000 unit (hedsmodel.EncoderUnit.typical, its edges at every phase of the
+    clock) turning at a constant speed: the FIFO's entries are hedsmodel.velocity.
+    ideal_edge_entries of its waveform, the input of the calibrated velocity bench (`make
+    velocity`): the same directions, states and times relative to the first entry (exact, but
+    +-1 tick for an edge within 2 ps of a clock edge, where the driver keeps it 1 ps clear)."""
+    fifo, _, rng = await fifo_of(dut)
+    unit = EncoderUnit.typical(np.random.default_rng(rng.getrandbits(32)))
+    rpm = rng.choice((1500.0, 3000.0, -2200.0))
+    n = fifo.depth - 1
+    wf = unit.waveform(Profile().constant(abs(rpm), 1.0 / (abs(rpm) / 60 * 500 * 4) * (n + 0.5)))
+    if rpm < 0:  # the same edges played backwards: the reversed walk
+        wf = walk([-1] * (len(wf.events) - 1), np.diff([t for t, _, _ in wf.events])[::-1],
+                  start_pos=wf.positions[-1])
+    et = edge_table(wf)
+    assert len(et.t_s) >= 2
+    await fifo.start()
+    a0, b0 = QUAD[wf.positions[0] % 4]  # the waveform's first state, then a clean FIFO
+    fifo.env.drv.set_state(a0, b0)
+    await ClockCycles(dut.clk, 30)
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1))
+    await fifo.play(wf)  # from a falling edge: clock edges at (k + 0.5) periods after its start
+    await ClockCycles(dut.clk, 12)
+    got = await fifo.drain()
+    tb = Timebase(clk_hz=1e9 / T_NS, ts_w=fifo.ts_w, phase=0.5)
+    ideal = ideal_edge_entries(wf, tb)
+    assert len(got) == len(ideal), f"{len(got)} entries, ideal {len(ideal)}"
+    mask = (1 << fifo.ts_w) - 1
+    for k, (g, i) in enumerate(zip(got, ideal)):
+        assert (g["DIR"], g["A"], g["B"]) == (int(i.up), i.a, i.b), f"entry {k}: {g}, ideal {i}"
+        d_got = (g["TIME"] - got[0]["TIME"]) & mask
+        d_ideal = (i.time - ideal[0].time) & mask
+        frac = et.t_s[k] * 1e9 / T_NS - 0.5
+        near = min(abs(frac - round(frac)), abs(et.t_s[0] * 1e9 / T_NS - 0.5
+                                                 - round(et.t_s[0] * 1e9 / T_NS - 0.5))) < 2e-4
+        assert d_got == d_ideal or (near and abs(d_got - d_ideal) <= 1), \
+            f"entry {k}: +{d_got} ticks after the first, ideal +{d_ideal}"
+    dut._log.info("%d entries of a typical unit at %g rpm match ideal_edge_entries", len(got), rpm)
 
 
 # ---- pytest --------------------------------------------------------------------------------------
