@@ -67,13 +67,22 @@ class Fifo:
             assert held == out[-1]["TIME"], f"EFIFO_TIME {held:#x} after the drain, last {out[-1]['TIME']:#x}"
         return out
 
-    async def start(self, func="x4", thresh=1):
+    async def start(self, func="x4", thresh=1, clear=True):
+        """Count with ``func``, the FIFO on (with CLEAR unless ``clear`` is False: then it must
+        be empty from the reset alone), EFIFO_LOST and EVENTS cleared."""
         model = QeiModel(self.env.count_w)
         await self.env.setup(model, func=func)
-        await self.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=thresh))
-        await self.bus.wr("EFIFO_LOST", 0)
+        await self.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=int(clear), THRESH=thresh))
+        if clear:
+            await self.bus.wr("EFIFO_LOST", 0)
         await self.bus.events()
         return model
+
+    async def check_empty(self, what: str):
+        assert get_field("EFIFO_STATUS", "LEVEL", await self.bus.rd("EFIFO_STATUS")) == 0, what
+        assert await self.bus.rd("EFIFO_ENTRY") == 0, what
+        assert await self.bus.rd("EFIFO_TIME") == 0, what
+        assert await self.bus.rd("EFIFO_LOST") == 0, what
 
     def walk(self, rng, n: int, lo: int, hi: int, p_rev: float = 0.3):
         """n steps, each state lasting lo .. hi whole clocks; returns the waveform and the list
@@ -138,10 +147,12 @@ async def _start(dut):
 async def entries_match_the_walk(dut):
     """A random walk (reversals at any state) read back in full: every step in order with its
     direction, A/B state and clock-exact time; the last entry's time is SNAP_EDGE_TIME; CAPS says
-    the depth; the other channel's FIFO stays empty."""
+    the depth; the other channel's FIFO stays empty. The first round uses the FIFO as the reset
+    left it (no CLEAR)."""
     fifo, envs, rng = await fifo_of(dut)
     assert get_field("CAPS", "EFIFO_LOG2", await fifo.bus.rd("CAPS")) == int(dut.EFIFO_LOG2.value)
-    await fifo.start()
+    await fifo.check_empty("after reset")
+    await fifo.start(clear=False)  # (the first round from the reset state alone)
     for rnd in range(3):
         if rnd == 1 and fifo.ts_w == 16:  # let the timebase wrap inside this round's walk
             tb = await fifo.bus.rd("TIMEBASE")
@@ -225,6 +236,9 @@ async def threshold_event_and_irq(dut):
     await fifo.play(wf)
     await ClockCycles(dut.clk, 12)
     assert "EFIFO_THRESH" in await fifo.bus.events(), "THRESH 0 with one entry"
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=0))
+    await fifo.bus.events()
+    assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False), "THRESH 0, FIFO empty"
     await fifo.start(thresh=thresh)
     await fifo.bus.wr("IRQ_EN", event_bits("EFIFO_THRESH"))
     wf, _ = fifo.walk(rng, thresh - 1, 3, 9)
@@ -254,6 +268,35 @@ async def threshold_event_and_irq(dut):
     assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == 0
     assert await fifo.bus.rd("EFIFO_ENTRY") == 0
     assert await fifo.bus.rd("EFIFO_TIME") == time
+
+
+@cocotb_test()
+async def reset_with_entries(dut):
+    """rst while the FIFO holds entries, a loss is pending and the shaft moves: after it the FIFO
+    is empty, EFIFO_TIME and EFIFO_LOST read 0, EN is off; enabled again (no CLEAR) it stores the
+    next walk exactly, with no LOST mark."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    wf, _ = fifo.walk(rng, fifo.depth + 3, 3, 8)
+    await fifo.play(wf)
+    await fifo.pop()
+    wf, _ = fifo.walk(rng, 40, 3, 8)
+    player = cocotb.start_soon(fifo.play(wf))
+    await ClockCycles(dut.clk, rng.randint(20, 120))
+    await FallingEdge(dut.clk)
+    dut.rst.value = 1
+    await ClockCycles(dut.clk, 3)
+    await FallingEdge(dut.clk)
+    dut.rst.value = 0
+    await player
+    await ClockCycles(dut.clk, 30)
+    await fifo.check_empty("after rst with entries")
+    assert get_field("EFIFO_CTRL", "EN", await fifo.bus.rd("EFIFO_CTRL")) == 0
+    await fifo.start(clear=False)
+    wf, steps = fifo.walk(rng, fifo.depth - 1, 3, 20)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    match(await fifo.drain(), steps, fifo.ts_w, 0, "after rst")
 
 
 @cocotb_test()
