@@ -246,52 +246,13 @@ module enc_qei_channel #(
           .ev_stall       (ev_stall)
       );
 
-      if (EFIFO_LOG2 != 0) begin : g_efifo
-        wire [TS_W-1:0] efifo_time;
-
-        enc_qei_efifo #(
-            .DEPTH_LOG2(EFIFO_LOG2),
-            .TS_W      (TS_W)
-        ) u_efifo (
-            .clk      (clk),
-            .rst      (rst),
-            .timebase (timebase),
-            .step_up  (step_up),
-            .step_dn  (step_dn),
-            .step_ab  (step_ab),
-            .ev_index (ev_index),
-            .en       (r2h_efifo_ctrl_en),
-            .clear    (r2h_efifo_ctrl_clear),
-            .thresh   (r2h_efifo_ctrl_thresh),
-            .pop      (r2h_efifo_entry_rd),
-            .entry    (h2r_efifo_entry),
-            .pop_time (efifo_time),
-            .level    (h2r_efifo_status_level),
-            .ev_thresh(ev_efifo_thresh),
-            .ev_ovf   (ev_efifo_ovf),
-            .lost_incr(h2r_efifo_lost_incr)
-        );
-
-        assign h2r_efifo_time = zext_ts(efifo_time);
-      end else begin : g_no_efifo
-        wire unused_efifo = &{1'b0, step_ab, r2h_efifo_ctrl_en, r2h_efifo_ctrl_clear,
-                              r2h_efifo_ctrl_thresh, r2h_efifo_entry_rd};
-        assign h2r_efifo_entry        = 32'd0;
-        assign h2r_efifo_time         = 32'd0;
-        assign h2r_efifo_status_level = 9'd0;
-        assign h2r_efifo_lost_incr    = 1'b0;
-        assign ev_efifo_thresh        = 1'b0;
-        assign ev_efifo_ovf           = 1'b0;
-      end
-
       assign h2r_snap_count     = zext_count(snap_count);
       assign h2r_snap_time      = zext_ts(snap_time);
       assign h2r_snap_edge_time = zext_ts(snap_edge_time);
       assign h2r_period         = zext_ts(period);
     end else begin : g_no_timing
       wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn, applied_up, applied_dn,
-                             snap_in, tick, gsnap, step_ab, r2h_efifo_ctrl_en, r2h_efifo_ctrl_clear,
-                             r2h_efifo_ctrl_thresh, r2h_efifo_entry_rd};
+                             snap_in, tick, gsnap};
       assign h2r_snap_count             = 64'd0;
       assign h2r_snap_time              = 32'd0;
       assign h2r_snap_edge_time         = 32'd0;
@@ -305,12 +266,47 @@ module enc_qei_channel #(
       assign ev_period                  = 1'b0;
       assign ev_period_ovf              = 1'b0;
       assign ev_stall                   = 1'b0;
-      assign h2r_efifo_entry            = 32'd0;
-      assign h2r_efifo_time             = 32'd0;
-      assign h2r_efifo_status_level     = 9'd0;
-      assign h2r_efifo_lost_incr        = 1'b0;
-      assign ev_efifo_thresh            = 1'b0;
-      assign ev_efifo_ovf               = 1'b0;
+    end
+  endgenerate
+
+  // the edge-capture FIFO (enc_qei allows it only with the timing unit: its timebase)
+  generate
+    if (EFIFO_LOG2 != 0) begin : g_efifo
+      wire [TS_W-1:0] efifo_time;
+
+      enc_qei_efifo #(
+          .DEPTH_LOG2(EFIFO_LOG2),
+          .TS_W      (TS_W)
+      ) u_efifo (
+          .clk      (clk),
+          .rst      (rst),
+          .timebase (timebase),
+          .step_up  (step_up),
+          .step_dn  (step_dn),
+          .step_ab  (step_ab),
+          .ev_index (ev_index),
+          .en       (r2h_efifo_ctrl_en),
+          .clear    (r2h_efifo_ctrl_clear),
+          .thresh   (r2h_efifo_ctrl_thresh),
+          .pop      (r2h_efifo_entry_rd),
+          .entry    (h2r_efifo_entry),
+          .pop_time (efifo_time),
+          .level    (h2r_efifo_status_level),
+          .ev_thresh(ev_efifo_thresh),
+          .ev_ovf   (ev_efifo_ovf),
+          .lost_incr(h2r_efifo_lost_incr)
+      );
+
+      assign h2r_efifo_time = zext_ts(efifo_time);
+    end else begin : g_no_efifo
+      wire unused_efifo = &{1'b0, step_ab, r2h_efifo_ctrl_en, r2h_efifo_ctrl_clear,
+                            r2h_efifo_ctrl_thresh, r2h_efifo_entry_rd};
+      assign h2r_efifo_entry        = 32'd0;
+      assign h2r_efifo_time         = 32'd0;
+      assign h2r_efifo_status_level = 9'd0;
+      assign h2r_efifo_lost_incr    = 1'b0;
+      assign ev_efifo_thresh        = 1'b0;
+      assign ev_efifo_ovf           = 1'b0;
     end
   endgenerate
 

@@ -28,6 +28,7 @@ from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
 from enctools.qei.bus import T_NS
 from enctools.qei.env import build_name, channel_envs, begin
 from enctools.qei.model import QeiModel
+from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import enum, event_bits, get_field, pack
 from enctools.tb import cocotb_test
 
@@ -283,11 +284,7 @@ async def reset_with_entries(dut):
     wf, _ = fifo.walk(rng, 40, 3, 8)
     player = cocotb.start_soon(fifo.play(wf))
     await ClockCycles(dut.clk, rng.randint(20, 120))
-    await FallingEdge(dut.clk)
-    dut.rst.value = 1
-    await ClockCycles(dut.clk, 3)
-    await FallingEdge(dut.clk)
-    dut.rst.value = 0
+    await pulse_rst(dut, 3)
     await player
     await ClockCycles(dut.clk, 30)
     await fifo.check_empty("after rst with entries")
