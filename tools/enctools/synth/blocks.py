@@ -87,6 +87,11 @@ BLOCKS = [
     # COUNT_W 16 with the function fixed (FUNC_MASK 1: x4 only), no timing unit: the row to
     # compare with the bare open decoders
     Block("enc_qei_wb", {"COUNT_W": 16, "PROFILE": 1, "FUNC_MASK": 1}, seeds=3),
+    # the edge-capture FIFO of one full channel at 16, 64 and 256 entries: its cost is the
+    # difference to the first enc_qei_wb row (report.efifo_table); --quick builds the 16 only
+    Block("enc_qei_wb", {"COUNT_W": 32, "EFIFO_LOG2": 4}, seeds=3),
+    Block("enc_qei_wb", {"COUNT_W": 32, "EFIFO_LOG2": 6}, seeds=3, quick=None),
+    Block("enc_qei_wb", {"COUNT_W": 32, "EFIFO_LOG2": 8}, seeds=3, quick=None),
     # several channels: 16 lean ones on the HX8K, 8 full ones on the ECP5. --quick places 2 lean
     # channels on the HX8K (the multi-channel flow in about a minute) and leaves the ECP5 row out
     # (its place and route takes tens of minutes; the one-channel ECP5 rows check that flow)

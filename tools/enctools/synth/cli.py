@@ -60,7 +60,7 @@ from ..paths import TOP
 from .blocks import BLOCKS, BUILD, CHANNELS_MD, RESULTS_MD, SEED, WAIVERS, Block, Result
 from .build import Waiver, load_waivers, merge_seeds, seed_run, synthesize
 from .channels import SWEEP_CHANNELS, SWEEP_DEVICES, SWEEP_PROFILES, channel_table, channels_markdown, sweep_block
-from .report import changes, markdown, previous_rows, table
+from .report import changes, efifo_table, markdown, previous_rows, table
 
 
 def parse_channels(text: str) -> list[int]:
@@ -203,6 +203,8 @@ def main() -> int:
     if blocks:
         print()
         print(table(ordered))
+        for line in efifo_table(ordered):
+            print(line)
         if write:
             RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
             RESULTS_MD.write_text(markdown(ordered))
