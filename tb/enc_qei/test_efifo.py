@@ -272,6 +272,52 @@ async def threshold_event_and_irq(dut):
 
 
 @cocotb_test()
+async def x2a_steps_only(dut):
+    """With CTRL.FUNC = x2a only the transitions of A are steps: the entries are exactly those
+    steps (direction, state, time), the transitions of B leave no entry."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start(func="x2a")
+    wf, steps = fifo.walk(rng, fifo.depth - 1, 3, 20)
+    before = [wf.positions[0]] + [p for _, _, _, p in steps[:-1]]
+    a_steps = [st for st, p0 in zip(steps, before) if QUAD[p0 % 4][0] != st[2][0]]
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    entries = await fifo.drain()
+    assert len(entries) == len(a_steps), f"{len(entries)} entries, {len(a_steps)} steps of A"
+    t0 = a_steps[0][0]
+    match(entries, [(t - t0, s_, ab, p) for t, s_, ab, p in a_steps], fifo.ts_w, 0, "x2a")
+
+
+@cocotb_test()
+async def en_off_keeps_lost_forgets_idx(dut):
+    """A loss pending when EN goes to 0 marks the first entry after EN returns to 1; an index edge
+    while EN = 0 (Z rising with the shaft standing) marks nothing; steps while EN = 0 are neither
+    entries nor losses."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    wf, _ = fifo.walk(rng, fifo.depth + 2, 3, 8)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=0, THRESH=1))
+    assert len(await fifo.drain()) == fifo.depth
+    wf, _ = fifo.walk(rng, 3, 3, 8)
+    await fifo.play(wf)
+    a, b = QUAD[fifo.env.pos % 4]
+    fifo.env.drv.set_state(a, b, 1)  # an index edge while EN = 0
+    await ClockCycles(dut.clk, 12)
+    assert "INDEX" in await fifo.bus.events(), "the Z edge is an index"
+    await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, THRESH=1))
+    wf, steps = fifo.walk(rng, 2, 3, 8, p_rev=0.0)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    after = await fifo.drain()
+    assert [(e["LOST"], e["IDX"]) for e in after] == [(1, 0), (0, 0)], \
+        f"(LOST, IDX) after EN 0 -> 1: {[(e['LOST'], e['IDX']) for e in after]}"
+    assert await fifo.bus.rd("EFIFO_LOST") == 2, "steps while EN = 0 counted as lost"
+    fifo.env.drv.set_state(*QUAD[fifo.env.pos % 4], 0)
+
+
+@cocotb_test()
 async def reset_with_entries(dut):
     """rst while the FIFO holds entries, a loss is pending and the shaft moves: after it the FIFO
     is empty, EFIFO_TIME and EFIFO_LOST read 0, EN is off; enabled again (no CLEAR) it stores the
