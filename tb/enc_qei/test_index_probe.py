@@ -386,6 +386,41 @@ async def index_preset_at_wraps(dut):
             model.idx_action = "none"
 
 
+@cocotb_test()
+async def index_preset_slice_compares(dut):
+    """An index preset of a PRESET below, at or above CEILING, differing in one 16-bit slice above the
+    lowest (the preset is compared with CEILING slice by slice for the range), in modulo, then
+    steps up and down: below CEILING it counts on, at or above it wraps (every bit of every upper
+    slice of CEILING and PRESET must reach that compare, the slice's bit 0 set or not)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    await env.setup(model, rng_mode="modulo", filter_len=1, count=0)
+    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+    model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+    model.idx_gate, model.idx_arm = None, True
+    for k in range(1, (env.count_w + 15) // 16):
+        for bit in range(16):
+            for low in (0x0001, 0x0000):
+                ceiling = (1 << bit | low) << 16 * k | 5  # (lower slices 5: CEILING - 1 keeps slice k)
+                if ceiling >> env.count_w:
+                    continue
+                await bus.set64("CEILING", ceiling)
+                model.ceiling = ceiling
+                for preset in (((1 << bit) - 1 | low) << 16 * k | 5, ceiling - 1, ceiling,
+                               ((1 << bit) + 1 | low) << 16 * k):
+                    if preset >> env.count_w:
+                        continue
+                    await bus.set64("PRESET", preset)
+                    model.preset = preset
+                    await play_clocks(env, model, step_clocks(env.pos, (+1, +1, -1, 0), (1, 0, 0, 0)))
+                    await env.settle(4)
+                    await env.check(model, f"CEILING {ceiling:#x}: PRESET {preset:#x} by the index, "
+                                    "then +1 -1")
+    await bus.wr("INDEX_CTRL", 0)
+    model.idx_action = "none"
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_index_probe(top, count_w, ts_w):

@@ -195,6 +195,31 @@ async def single_bit_ceilings(dut):
                 await env.check(model, f"{mode} CEILING {ceiling:#x}, steps from 0")
 
 
+@cocotb_test()
+async def ceiling_slice_compares(dut):
+    """COUNT loaded just below or above CEILING in one 16-bit slice above the lowest (the count
+    compares with CEILING slice by slice: a >= b from the slices' > and >=), in modulo, then one
+    step up and one down: below it counts on, at or above it wraps (every bit of every upper
+    slice of CEILING must reach the compare, with the slice's bit 0 set or not)."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    await env.setup(model, rng_mode="modulo", filter_len=1, count=0)
+    for k in range(1, (env.count_w + 15) // 16):
+        for bit in range(16):
+            for low in (0x0001, 0x0000):
+                ceiling = (1 << bit | low) << 16 * k | 5  # (lower slices 5: CEILING - 1 keeps slice k)
+                if ceiling >> env.count_w:
+                    continue
+                for count in (((1 << bit) - 1 | low) << 16 * k | 5, ceiling - 1, ceiling,
+                              ((1 << bit) + 1 | low) << 16 * k):
+                    if count >> env.count_w:
+                        continue
+                    await env.bus.set64("CEILING", ceiling)
+                    model.ceiling = ceiling
+                    await steps_from(env, model, count, (+1, -1))
+                    await env.check(model, f"CEILING {ceiling:#x}, COUNT {count:#x}, +1 -1")
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
 def test_ranges(top, count_w, ts_w):
