@@ -304,7 +304,7 @@ async def global_snapshot_one_channel(dut):
     """The global snapshot of a one-channel build: by GSNAP_CTRL.CMD (ten of them, at timebase
     values 173 clocks and a bus transfer apart), by a rising snap_in with GSNAP_CTRL.IN_EN (none
     without it; GSNAP_TIME between the TIMEBASE values read before and after) and by the global
-    unit timer (GSNAP_PERIOD 0x155: consecutive GSNAP_TIMEs exactly that far apart). Each one
+    unit timer (GSNAP_PERIOD 0x155, then 0x0AA: consecutive GSNAP_TIMEs exactly that far apart). Each one
     latches the channel's snapshot in its own clock (SNAP_TIME = GSNAP_TIME) and raises
     SNAP_READY."""
     env, rng = await begin(dut)
@@ -351,20 +351,23 @@ async def global_snapshot_one_channel(dut):
             f"snap_in snapshot {i}: GSNAP_TIME {gtime:#x} outside {before:#x}..{after:#x}"
     await bus.wr("GSNAP_CTRL", 0)
 
-    period = 0x155
-    await bus.wr("GSNAP_PERIOD", period)
-    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
-    times = []
-    while len(times) < 4:
-        await ClockCycles(dut.clk, 40)
-        if not await bus.rd("EVENTS") & ready:
-            continue
-        gtime = await taken(f"timer snapshot {len(times)}")
-        assert await bus.rd("GSNAP_TIME") == gtime, "the unit timer fired again during the reads"
-        times.append(gtime)
-    await bus.wr("GSNAP_CTRL", 0)
-    gaps = [(b - a) & ts_mask for a, b in zip(times, times[1:])]
-    assert gaps == [period] * 3, f"GSNAP_TIMEs {[hex(t) for t in times]}: gaps {gaps}, GSNAP_PERIOD {period}"
+    for period in (0x155, 0x0AA):  # every bit of 0 .. 8 set in one of the two, clear in the other
+        await bus.wr("GSNAP_PERIOD", period)
+        await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+        times = []
+        while len(times) < 4:
+            await ClockCycles(dut.clk, 40)
+            if not await bus.rd("EVENTS") & ready:
+                continue
+            gtime = await taken(f"timer snapshot {len(times)}")
+            assert await bus.rd("GSNAP_TIME") == gtime, "the unit timer fired again during the reads"
+            times.append(gtime)
+        await bus.wr("GSNAP_CTRL", 0)
+        await env.settle(4)
+        await bus.wr("EVENTS", ready)
+        gaps = [(b - a) & ts_mask for a, b in zip(times, times[1:])]
+        assert gaps == [period] * 3, \
+            f"GSNAP_TIMEs {[hex(t) for t in times]}: gaps {gaps}, GSNAP_PERIOD {period:#x}"
 
 
 @cocotb_test()
