@@ -31,23 +31,29 @@ def save_results(root: Path, modules, corners, mutants, run: dict, notes: list[s
 
 
 def load_results(paths: list[Path]):
-    """Corners, mutants, modules, runs and notes of one or more results.json files."""
+    """Corners, mutants, modules, runs and notes of one or more results.json files. A module in
+    several of them is taken from the last one only (a module run again after tests were added
+    replaces its earlier run)."""
     modules, corners, mutants, runs, notes = [], [], [], [], []
+    datas = []
     for path in paths:
         if not path.exists():
             sys.exit(f"mutate --report: no {path}; run make mutate first")
-        data = json.loads(path.read_text())
+        datas.append(json.loads(path.read_text()))
+    last = {m: i for i, data in enumerate(datas) for m in data["modules"]}
+    for i, data in enumerate(datas):
         gen.set_snapshot(Path(data["snapshot"]))
         cs = []
         for c in data["corners"]:
             spec = MODULES.get(c["module"]) or Module("", ())
             cs.append(Corner(c["module"], spec.file, c["params"], c["defaults"],
                              [Group(**g) for g in c["groups"]], c["index"], spec, c["baseline_s"]))
+        keep = [last[c.module] == i for c in cs]
         mutants += [Mutant(cs[m["corner"]], m["number"], m["command"], Path(m["path"]),
                            m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
-                    for m in data["mutants"]]
-        modules += [m for m in data["modules"] if m not in modules]
-        corners += cs
+                    for m in data["mutants"] if keep[m["corner"]]]
+        modules += [m for m in data["modules"] if m not in modules and last[m] == i]
+        corners += [c for c, k in zip(cs, keep) if k]
         runs.append(data["run"])
         notes += data.get("notes", [])
     modules = [m for m in MODULES if m in modules] + [m for m in modules if m not in MODULES]
