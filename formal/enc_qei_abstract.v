@@ -24,7 +24,8 @@ module enc_qei #(
     parameter integer COUNT_W    = 32,
     parameter integer TS_W       = 32,
     parameter integer PROFILE    = 2,
-    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL
+    parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL,
+    parameter integer EFIFO_LOG2 = 0
 ) (
     input  wire        clk,
     input  wire        rst,
