@@ -387,6 +387,34 @@ async def index_preset_at_wraps(dut):
 
 
 @cocotb_test()
+async def z_and_probe_filter_lengths(dut):
+    """Z and probe_in go through a filter of CTRL.FILTER_LEN samples like A and B: at FILTER_LEN
+    4 .. 7 and 12 .. 15 (bit 2 set) and 8, a pulse of FILTER_LEN - 1 clocks is rejected (no INDEX,
+    no PROBE event) and one of FILTER_LEN + 1 clocks is taken (INDEX on its rising edge, PROBE
+    with PROBE_CTRL on rising edges)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for f in (4, 5, 6, 7, 8, 12, 15):
+        await env.setup(model, filter_len=f)
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
+        await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
+        for sig, event in ((dut.z_in, "INDEX"), (dut.probe_in, "PROBE")):
+            for clocks, taken in ((f - 1, False), (f + 1, True)):
+                await bus.events()
+                await FallingEdge(dut.clk)
+                sig.value = 1
+                await ClockCycles(dut.clk, clocks)
+                await FallingEdge(dut.clk)
+                sig.value = 0
+                await ClockCycles(dut.clk, 2 * f + 8)
+                ev = await bus.events()
+                assert (event in ev) == taken, \
+                    f"FILTER_LEN {f}: a {clocks}-clock pulse on {event}: events {sorted(ev)}"
+    await bus.wr("PROBE_CTRL", 0)
+
+
+@cocotb_test()
 async def index_preset_slice_compares(dut):
     """An index preset of a PRESET below, at or above CEILING, differing in one 16-bit slice above the
     lowest (the preset is compared with CEILING slice by slice for the range), in modulo, then

@@ -372,14 +372,22 @@ async def global_snapshot_one_channel(dut):
 
 @cocotb_test()
 async def unit_timer_high_bits(dut):
-    """SNAP_PERIOD and GSNAP_PERIOD with a high bit set (bit TS_W - 1, then bits 12 .. 15, each with
-    3 ticks more): no snapshot within 600 clocks of setting PERIOD_EN (a period bit lost on its
-    way to a timer would make it fire after a few ticks)."""
+    """SNAP_PERIOD and GSNAP_PERIOD with a high bit set (each of bits 10 .. TS_W - 1, with 3 ticks
+    more): no snapshot within 600 clocks of setting PERIOD_EN (a period bit lost on its way to a
+    timer would make it fire after a few ticks). And with PERIOD_EN = 0 and the period 0x7FF
+    (bits 0 .. 10 set), no snapshot in 2,100 clocks (PERIOD_EN must not depend on the period)."""
     env, rng = await begin(dut)
     bus = env.bus
     ready = event_bits("SNAP_READY")
     ts_w = int(dut.TS_W.value)
-    for bit in sorted({ts_w - 1, 15, 14, 13, 12}, reverse=True):
+    for reg, ctrl_reg in (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL")):
+        await bus.wr(reg, 0x7FF)
+        await bus.events()
+        await bus.wr(ctrl_reg, 0)
+        await ClockCycles(dut.clk, 2100)
+        assert not await bus.rd("EVENTS") & ready, f"{reg} 0x7ff with PERIOD_EN = 0: a snapshot"
+        await bus.wr(reg, 0)
+    for bit in range(ts_w - 1, 9, -1):
         period = 1 << bit | 3
         for reg, ctrl_reg in (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL")):
             await bus.wr(reg, period)
