@@ -16,7 +16,8 @@
 // dropped, pulses lost_incr (EFIFO_LOST) and ev_ovf (EVENTS.EFIFO_OVF), and marks the next entry
 // stored (LOST). A qualified index edge marks the entry of its own clock, or the next one stored
 // (IDX). clear empties the FIFO and forgets both marks (a step in its clock is not stored); while
-// en = 0 nothing is pushed and nothing is marked.
+// en = 0 nothing is pushed, an index marks nothing and a pending IDX mark is dropped (a pending
+// LOST mark stays: the loss happened).
 `default_nettype none
 
 module enc_qei_efifo #(
