@@ -15,7 +15,7 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
 from hedsmodel import walk
 
-from enctools.qei.bus import PERIOD_PS, T_NS
+from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations
@@ -306,16 +306,7 @@ async def wb_abandoned_cycle(dut):
     unmapped = max(r.offset for r in regmap().values()) + 4
     for hold, adr in ((1, regmap()["ID"].offset), (2, regmap()["ID"].offset), (1, unmapped),
                       (2, unmapped)):
-        await FallingEdge(dut.clk)
-        dut.wb_adr_i.value = adr
-        dut.wb_we_i.value = 0
-        dut.wb_sel_i.value = 0xF
-        dut.wb_cyc_i.value = 1
-        dut.wb_stb_i.value = 1
-        await ClockCycles(dut.clk, hold)
-        await FallingEdge(dut.clk)
-        dut.wb_cyc_i.value = 0
-        dut.wb_stb_i.value = 0
+        await wb_abandon_read(dut, adr, hold)
         for k in range(8):
             await Timer(PERIOD_PS // 10, unit="ps")  # the same clock, CYC already low
             assert dut.wb_ack_o.value == 0 and dut.wb_err_o.value == 0, \

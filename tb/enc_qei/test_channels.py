@@ -17,7 +17,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Time
 from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel import QUAD, random_walk, walk
 
-from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
+from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, wb_abandon_read
 from enctools.qei.env import FILTER, begin, build_name, channel_envs
 from enctools.qei.model import QUAD_FUNCS, QeiModel
 from enctools.regmap import PAGE, addr, enum, get_field, pack, regmap
@@ -390,16 +390,7 @@ async def lanes_probe_compare_per_channel(dut):
         for hold in (1, 2):
             # a read of CTRL abandoned after `hold` clocks, then at once a read of PRESET_LO: its
             # answer is PRESET_LO's, never the abandoned read's
-            await FallingEdge(dut.clk)
-            dut.wb_adr_i.value = k * PAGE + regmap()["CTRL"].offset
-            dut.wb_we_i.value = 0
-            dut.wb_sel_i.value = 0xF
-            dut.wb_cyc_i.value = 1
-            dut.wb_stb_i.value = 1
-            await ClockCycles(dut.clk, hold)
-            await FallingEdge(dut.clk)
-            dut.wb_cyc_i.value = 0
-            dut.wb_stb_i.value = 0
+            await wb_abandon_read(dut, k * PAGE + regmap()["CTRL"].offset, hold)
             await Timer(PERIOD_PS // 10, unit="ps")  # the same clock, CYC already low
             assert dut.wb_ack_o.value == 0 and dut.wb_err_o.value == 0, \
                 f"page {k}: ACK/ERR after the master dropped CYC"

@@ -17,7 +17,8 @@ from hedsmodel import QUAD, walk
 from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import WIDE, ceilings, durations, near, play_clocks, step_clocks
+from enctools.qei.stimulus import (WIDE, ceilings, durations, near, play_clocks, slice_compare_cases,
+                                   step_clocks)
 from enctools.regmap import pack, regmap
 from enctools.tb import cocotb_test
 
@@ -427,24 +428,15 @@ async def index_preset_slice_compares(dut):
     await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
     model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
     model.idx_gate, model.idx_arm = None, True
-    for k in range(1, (env.count_w + 15) // 16):
-        for bit in range(16):
-            for low in (0x0001, 0x0000):
-                ceiling = (1 << bit | low) << 16 * k | 5  # (lower slices 5: CEILING - 1 keeps slice k)
-                if ceiling >> env.count_w:
-                    continue
-                await bus.set64("CEILING", ceiling)
-                model.ceiling = ceiling
-                for preset in (((1 << bit) - 1 | low) << 16 * k | 5, ceiling - 1, ceiling,
-                               ((1 << bit) + 1 | low) << 16 * k):
-                    if preset >> env.count_w:
-                        continue
-                    await bus.set64("PRESET", preset)
-                    model.preset = preset
-                    await play_clocks(env, model, step_clocks(env.pos, (+1, +1, -1, 0), (1, 0, 0, 0)))
-                    await env.settle(4)
-                    await env.check(model, f"CEILING {ceiling:#x}: PRESET {preset:#x} by the index, "
-                                    "then +1 -1")
+    for ceiling, presets in slice_compare_cases(env.count_w):
+        await bus.set64("CEILING", ceiling)
+        model.ceiling = ceiling
+        for preset in presets:
+            await bus.set64("PRESET", preset)
+            model.preset = preset
+            await play_clocks(env, model, step_clocks(env.pos, (+1, +1, -1, 0), (1, 0, 0, 0)))
+            await env.settle(4)
+            await env.check(model, f"CEILING {ceiling:#x}: PRESET {preset:#x} by the index, then +1 -1")
     await bus.wr("INDEX_CTRL", 0)
     model.idx_action = "none"
 

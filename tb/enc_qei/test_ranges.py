@@ -18,7 +18,7 @@ from hedsmodel import random_walk, walk
 from enctools.qei.bus import T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
 from enctools.qei.model import RANGES, QeiModel
-from enctools.qei.stimulus import BURST, WIDE, durations, near, steps_from
+from enctools.qei.stimulus import BURST, WIDE, durations, near, slice_compare_cases, steps_from
 from enctools.regmap import get_field, pack, regmap
 from enctools.tb import cocotb_test
 
@@ -204,20 +204,12 @@ async def ceiling_slice_compares(dut):
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     await env.setup(model, rng_mode="modulo", filter_len=1, count=0)
-    for k in range(1, (env.count_w + 15) // 16):
-        for bit in range(16):
-            for low in (0x0001, 0x0000):
-                ceiling = (1 << bit | low) << 16 * k | 5  # (lower slices 5: CEILING - 1 keeps slice k)
-                if ceiling >> env.count_w:
-                    continue
-                for count in (((1 << bit) - 1 | low) << 16 * k | 5, ceiling - 1, ceiling,
-                              ((1 << bit) + 1 | low) << 16 * k):
-                    if count >> env.count_w:
-                        continue
-                    await env.bus.set64("CEILING", ceiling)
-                    model.ceiling = ceiling
-                    await steps_from(env, model, count, (+1, -1))
-                    await env.check(model, f"CEILING {ceiling:#x}, COUNT {count:#x}, +1 -1")
+    for ceiling, counts in slice_compare_cases(env.count_w):
+        await env.bus.set64("CEILING", ceiling)
+        model.ceiling = ceiling
+        for count in counts:
+            await steps_from(env, model, count, (+1, -1))
+            await env.check(model, f"CEILING {ceiling:#x}, COUNT {count:#x}, +1 -1")
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

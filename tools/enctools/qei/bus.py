@@ -16,6 +16,24 @@ PERIOD_PS = 10_000  # 100 MHz
 T_NS = PERIOD_PS / 1000
 
 
+async def wb_abandon_read(dut, adr: int, hold: int) -> None:
+    """Wishbone, driven by hand: a read of byte address ``adr`` that the master abandons after
+    ``hold`` clocks (CYC and STB high from a falling edge, then low at the falling edge ``hold``
+    clocks later). Returns in that clock, CYC already low."""
+    from cocotb.triggers import ClockCycles, FallingEdge
+
+    await FallingEdge(dut.clk)
+    dut.wb_adr_i.value = adr
+    dut.wb_we_i.value = 0
+    dut.wb_sel_i.value = 0xF
+    dut.wb_cyc_i.value = 1
+    dut.wb_stb_i.value = 1
+    await ClockCycles(dut.clk, hold)
+    await FallingEdge(dut.clk)
+    dut.wb_cyc_i.value = 0
+    dut.wb_stb_i.value = 0
+
+
 def signed(value: int, bits: int = 32) -> int:
     """A ``bits``-wide register value read as two's complement (SNAP_DELTA, a count)."""
     value &= (1 << bits) - 1

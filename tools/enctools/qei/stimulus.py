@@ -90,6 +90,25 @@ WIDE = (0x5A5A_A5A5_C3C3_3C3C, 0xA5A5_5A5A_3C3C_C3C3, 0x8000_0001_8000_0001, 0x7
 BURST = (-1, +1, 0, 0, +1, +1, 0, 0, -1, -1, 0, 0, +1, -1, 0, 0, -1, +1, +1, 0, 0, +1, -1, -1, 0)
 
 
+def slice_compare_cases(count_w: int) -> list:
+    """(CEILING, values) pairs for the count's slice-by-slice compare with CEILING (16-bit slices,
+    a >= b from each slice's > and >=): for every bit of every slice above the lowest, with the
+    slice's bit 0 set or not, a CEILING of that bit (lower slices 5, so CEILING - 1 keeps the
+    slice), and values below it in that slice, one below it in the lower slices, equal, and above
+    it; only those that fit COUNT_W bits."""
+    out = []
+    for k in range(1, (count_w + 15) // 16):
+        for bit in range(16):
+            for low in (0x0001, 0x0000):
+                ceiling = (1 << bit | low) << 16 * k | 5
+                if ceiling >> count_w:
+                    continue
+                values = (((1 << bit) - 1 | low) << 16 * k | 5, ceiling - 1, ceiling,
+                          ((1 << bit) + 1 | low) << 16 * k)
+                out.append((ceiling, [v for v in values if not v >> count_w]))
+    return out
+
+
 def ceilings(count_w, zero=True):
     """CEILINGs of 0, small ones, a high half that equals the count's with bit 27 set, bit 31
     and bit 63."""
