@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -36,17 +35,9 @@ TB = Timebase(latency_clocks=7)
 
 
 @pytest.fixture(scope="session")
-def c_calib(tmp_path_factory):
-    gcc = shutil.which("gcc")
-    if gcc is None:
-        pytest.skip("gcc not found: the C estimator cannot be compiled here")
-    out = tmp_path_factory.mktemp("calib_c") / "calib_driver"
-    cmd = [gcc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", f"-I{SW}",
-           str(SW / "enc_qei_calib.c"), str(Path(__file__).parent / "calib_driver.c"), "-lm",
-           "-o", str(out)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    assert res.returncode == 0, f"gcc failed:\n{' '.join(cmd)}\n{res.stderr}"
-    return out
+def c_calib(c_driver):
+    return c_driver("calib_driver", [SW / "enc_qei_calib.c", Path(__file__).parent / "calib_driver.c"],
+                    libs=["-lm"])
 
 
 def run_c(exe, cfg: CalibConfig, ops):

@@ -30,17 +30,8 @@ REL_TOL = 1e-12
 
 
 @pytest.fixture(scope="session")
-def c_estimator(tmp_path_factory):
-    gcc = shutil.which("gcc")
-    if gcc is None:
-        pytest.skip("gcc not found: the C estimator cannot be compiled here")
-    out = tmp_path_factory.mktemp("vel_c") / "vel_driver"
-    cmd = [gcc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", f"-I{SW}",
-           str(SW / "enc_qei_velocity.c"), str(Path(__file__).parent / "vel_driver.c"),
-           "-o", str(out)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    assert res.returncode == 0, f"gcc failed:\n{' '.join(cmd)}\n{res.stderr}"
-    return out
+def c_estimator(c_driver):
+    return c_driver("vel_driver", [SW / "enc_qei_velocity.c", Path(__file__).parent / "vel_driver.c"])
 
 
 def run_c(exe: Path, cfg: EstimatorConfig, snaps) -> list[tuple[float, float, float]]:
