@@ -253,6 +253,10 @@ CASES = {
     "glitches": lambda u, rng: _plain(u, lambda p: p.constant(V, 10.0), "300 rpm, 20 glitches "
                                       "(a step back and forth) while learning",
                                       fault=glitch_pairs(0.8, 1.6, 20)),
+    "step 30": lambda u, rng: _plain(u, lambda p: p.constant(30 * DETUNE, 7.0).constant(
+        33 * DETUNE, 24.0), "30 rpm, a 10 % speed step while learning"),
+    "step 3000": lambda u, rng: _plain(u, lambda p: p.constant(3000 * DETUNE, 0.1).constant(
+        3600 * DETUNE, 2.5), "3000 rpm, a 20 % speed step while learning"),
     "idx glitch learning": lambda u, rng: _plain(u, lambda p: p.constant(V, 10.0),
                                                  "300 rpm, a false IDX while learning",
                                                  fault=index_glitch(1.1)),
@@ -266,6 +270,12 @@ CASES = {
     "missed pulse": lambda u, rng: _plain(u, lambda p: p.constant(30 * DETUNE, 32.0),
                                           "30 rpm, a B pulse missing (a cycle off, no flag) "
                                           "after learning", 26.0, missed_pulse(26.0)),
+    "noise after": lambda u, rng: _plain(u, lambda p: p.constant(V, 8.0), "300 rpm, 5 µs rms "
+                                         "timing noise on the edges for 0.5 s after learning",
+                                         3.0, timing_noise(3.0, 3.5, 5e-6)),
+    "glitches after": lambda u, rng: _plain(u, lambda p: p.constant(V, 8.0), "300 rpm, 20 "
+                                            "glitches after learning", 3.0,
+                                            glitch_pairs(3.0, 3.5, 20)),
     "idx glitch": lambda u, rng: _plain(u, lambda p: p.constant(V, 8.0),
                                         "300 rpm, a false IDX after learning", 3.0,
                                         index_glitch(3.0)),
