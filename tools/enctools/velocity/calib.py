@@ -124,12 +124,12 @@ def run_latency(job) -> dict:
 
     tb, stall_s = job["tb"], job["stall_s"]
     v0, v1, hold, n_steps = LATENCY_RPM, LATENCY_RPM * LATENCY_STEP, job["hold_s"], job["steps"]
-    spec = [("constant", 60.0 * DETUNE, (LEARN_REVS + 3.2) * 1.0),
+    spec = [("constant", 60.0 * DETUNE, (LEARN_REVS + 4.2) * 1.0),
             ("ramp", 60.0 * DETUNE, v0 * DETUNE, 1.0), ("constant", v0 * DETUNE, 1.0)]
     for i in range(n_steps):
         spec.append(("constant", (v1 if i % 2 == 0 else v0) * DETUNE, hold))
     prof = _profile(spec)
-    t_first = (LEARN_REVS + 3.2) + 2.0
+    t_first = (LEARN_REVS + 4.2) + 2.0
     out = {"unit": job["unit_name"]}
     for play in job["plays"]:
         wf = _played(job["unit"], play).waveform(prof, index=True)

@@ -215,7 +215,7 @@ def _slip(deg, rpm=300.0):
     def case(unit, rng):
         u2 = dataclasses.replace(unit, eccentricity_angle_deg=unit.eccentricity_angle_deg + deg)
         t1 = 13 * 60.0 / rpm
-        return _after_split(unit, u2, rpm * DETUNE, t1, 14 * 60.0 / rpm,
+        return _after_split(unit, u2, rpm * DETUNE, t1, 20 * 60.0 / rpm,
                             f"hub slips {deg:g}° on its shaft at {rpm:g} rpm after learning")
     return case
 
