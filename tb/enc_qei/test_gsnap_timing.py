@@ -27,7 +27,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
 from enctools.regmap import pack
 from enctools.tb import cocotb_test
 

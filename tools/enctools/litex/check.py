@@ -334,11 +334,12 @@ def check_efifo(motions: list[motion.Motion], run: Run) -> EfifoResult:
                                "offset for every channel"))
     per = cycles / total if total else 0.0
     summary = [
-        f"edge FIFO: {total} entries drained from {nch} channels equal the model's steps (number, "
-        f"directions, direction changes, IDX marks, times = the step's clock + "
+        f"edge FIFO: {total} entries drained from {nch} channels "
+        f"{'equal' if not fails else 'compared with'} the model's steps (number, directions, "
+        f"direction changes, IDX marks, times = the step's clock + "
         f"{','.join(map(str, sorted(offsets))) or '-'}), times increasing, every (A, B) the "
-        f"successor of the previous, no LOST; {per:.0f} CPU cycles per entry (two reads and the "
-        f"firmware's bookkeeping)",
+        f"successor of the previous, no LOST{'' if not fails else ': ' + str(len(fails)) + ' differ'}"
+        f"; {per:.0f} CPU cycles per entry (two reads and the firmware's bookkeeping)",
     ]
     return EfifoResult(not fails, fails, total, offsets.pop() if len(offsets) == 1 else None, per,
                        summary)

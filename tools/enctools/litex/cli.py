@@ -196,3 +196,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"soc-sim: wrote {rel(RESULT_FILE)}")
     print(f"soc-sim: {time.monotonic() - t0:.0f} s in all")
     return 0 if ok_all else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
