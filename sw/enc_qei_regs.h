@@ -20,7 +20,7 @@ extern "C" {
 #define ENC_QEI__ID__VERSION_bm 0xffffu
 #define ENC_QEI__ID__VERSION_bp 0
 #define ENC_QEI__ID__VERSION_bw 16
-#define ENC_QEI__ID__VERSION_reset 0x101u
+#define ENC_QEI__ID__VERSION_reset 0x102u
 #define ENC_QEI__ID__MAGIC_bm 0xffff0000u
 #define ENC_QEI__ID__MAGIC_bp 16
 #define ENC_QEI__ID__MAGIC_bw 16
@@ -73,6 +73,10 @@ extern "C" {
 #define ENC_QEI__CTRL__INV_Z_bp 4
 #define ENC_QEI__CTRL__INV_Z_bw 1
 #define ENC_QEI__CTRL__INV_Z_reset 0x0u
+#define ENC_QEI__CTRL__CMP_EN_bm 0x20u
+#define ENC_QEI__CTRL__CMP_EN_bp 5
+#define ENC_QEI__CTRL__CMP_EN_bw 1
+#define ENC_QEI__CTRL__CMP_EN_reset 0x0u
 #define ENC_QEI__CTRL__FUNC_bm 0xf00u
 #define ENC_QEI__CTRL__FUNC_bp 8
 #define ENC_QEI__CTRL__FUNC_bw 4
