@@ -51,11 +51,11 @@ extern "C" {
 
 // reg - ID (0x00, global, page 0)
 #define ENC_QEI_ID_OFFSET 0x00u
-#define ENC_QEI_ID_RESET 0x51450101u
+#define ENC_QEI_ID_RESET 0x51450102u
 #define ENC_QEI__ID__VERSION_bm 0xffffu
 #define ENC_QEI__ID__VERSION_bp 0
 #define ENC_QEI__ID__VERSION_bw 16
-#define ENC_QEI__ID__VERSION_reset 0x101u
+#define ENC_QEI__ID__VERSION_reset 0x102u
 #define ENC_QEI__ID__VERSION_SET(v) ((uint32_t)(((uint32_t)(v) << ENC_QEI__ID__VERSION_bp) & ENC_QEI__ID__VERSION_bm))
 #define ENC_QEI__ID__VERSION_GET(w) ((uint32_t)(((uint32_t)(w) & ENC_QEI__ID__VERSION_bm) >> ENC_QEI__ID__VERSION_bp))
 #define ENC_QEI__ID__VERSION_UPDATE(w, v) ((uint32_t)(((uint32_t)(w) & ~ENC_QEI__ID__VERSION_bm) | ENC_QEI__ID__VERSION_SET(v)))
@@ -162,6 +162,13 @@ extern "C" {
 #define ENC_QEI__CTRL__INV_Z_SET(v) ((uint32_t)(((uint32_t)(v) << ENC_QEI__CTRL__INV_Z_bp) & ENC_QEI__CTRL__INV_Z_bm))
 #define ENC_QEI__CTRL__INV_Z_GET(w) ((uint32_t)(((uint32_t)(w) & ENC_QEI__CTRL__INV_Z_bm) >> ENC_QEI__CTRL__INV_Z_bp))
 #define ENC_QEI__CTRL__INV_Z_UPDATE(w, v) ((uint32_t)(((uint32_t)(w) & ~ENC_QEI__CTRL__INV_Z_bm) | ENC_QEI__CTRL__INV_Z_SET(v)))
+#define ENC_QEI__CTRL__CMP_EN_bm 0x20u
+#define ENC_QEI__CTRL__CMP_EN_bp 5
+#define ENC_QEI__CTRL__CMP_EN_bw 1
+#define ENC_QEI__CTRL__CMP_EN_reset 0x0u
+#define ENC_QEI__CTRL__CMP_EN_SET(v) ((uint32_t)(((uint32_t)(v) << ENC_QEI__CTRL__CMP_EN_bp) & ENC_QEI__CTRL__CMP_EN_bm))
+#define ENC_QEI__CTRL__CMP_EN_GET(w) ((uint32_t)(((uint32_t)(w) & ENC_QEI__CTRL__CMP_EN_bm) >> ENC_QEI__CTRL__CMP_EN_bp))
+#define ENC_QEI__CTRL__CMP_EN_UPDATE(w, v) ((uint32_t)(((uint32_t)(w) & ~ENC_QEI__CTRL__CMP_EN_bm) | ENC_QEI__CTRL__CMP_EN_SET(v)))
 #define ENC_QEI__CTRL__FUNC_bm 0xf00u
 #define ENC_QEI__CTRL__FUNC_bp 8
 #define ENC_QEI__CTRL__FUNC_bw 4
