@@ -71,6 +71,17 @@ void enc_qei_write_count(volatile enc_qei_chan_t *q, uint64_t value)
     q->COUNT_LO = (uint32_t)value;         /* loads {staged HI, LO}, clears STATUS.STOPPED */
 }
 
+void enc_qei_compare_at(volatile enc_qei_chan_t *q, uint64_t value)
+{
+    q->COMPARE_HI = (uint32_t)(value >> 32);
+    q->COMPARE_LO = (uint32_t)value;
+    q->EVENTS = ENC_QEI__EVENTS__CMP_bm;
+    q->IRQ_EN = q->IRQ_EN | ENC_QEI__EVENTS__CMP_bm;
+    /* last: compare on, COMPARE already in place (turning it on while the count equals COMPARE
+     * raises nothing) */
+    q->CTRL = ENC_QEI__CTRL__CMP_EN_UPDATE(q->CTRL, 1u);
+}
+
 /* pending INDEX cleared, INDEX enabled onto irq (other enables kept) */
 static void enable_index_irq(volatile enc_qei_chan_t *q)
 {

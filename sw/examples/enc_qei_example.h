@@ -48,6 +48,12 @@ uint64_t enc_qei_read_count(volatile enc_qei_chan_t *q);
 /* Set the count: COUNT_HI first (staged), then COUNT_LO (loads both). */
 void enc_qei_write_count(volatile enc_qei_chan_t *q, uint64_t value);
 
+/* Compare: EVENTS.CMP (and a cmp_out pulse) each time the count changes to `value`: COMPARE
+ * written (HI first), the CMP interrupt enabled (a stale CMP cleared), then CTRL.CMP_EN set with
+ * CTRL's other fields kept. CTRL.CMP_EN is in register maps from 1.2 (ID.VERSION 0x0102) on, in
+ * builds with compare (not the lean profile). */
+void enc_qei_compare_at(volatile enc_qei_chan_t *q, uint64_t value);
+
 /* Homing, preset variant: load home_value into the count on the first index pulse, once
  * (INDEX_CTRL.ACTION = preset, ONESHOT, ARM), optionally gated by the (A, B) state gate_ab
  * (bit 1 = A, bit 0 = B; gate_ab < 0: no gate), and enable the INDEX interrupt. */

@@ -116,6 +116,17 @@ int main(void)
     PS("signed.min_64", enc_qei_to_signed(0x8000000000000000ull, 64u));
     PS("signed.min_64_plus1", enc_qei_to_signed(0x8000000000000001ull, 64u) + 1);
 
+    /* compare: CTRL's other fields kept, CMP_EN set */
+    memset(&regs, 0, sizeof regs);
+    regs.CTRL = enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X1A_VAL, ENC_QEI__CTRL__RANGE__MODULO_VAL, 9u);
+    regs.IRQ_EN = ENC_QEI__EVENTS__INDEX_bm;
+    enc_qei_compare_at(Q, 0x0000000300000010ull);
+    P("cmp.COMPARE_LO", regs.COMPARE_LO);
+    P("cmp.COMPARE_HI", regs.COMPARE_HI);
+    P("cmp.CTRL", regs.CTRL);
+    P("cmp.IRQ_EN", regs.IRQ_EN);
+    P("cmp.EVENTS", regs.EVENTS);
+
     /* homing by preset, gated at (A, B) = (1, 0) */
     memset(&regs, 0, sizeof regs);
     regs.IRQ_EN = ENC_QEI__EVENTS__CMP_bm;
@@ -221,6 +232,16 @@ def test_count_arithmetic(harness_out):
     assert o["signed.neg1_64"] == -1
     assert o["signed.min_64"] == -(1 << 63)
     assert o["signed.min_64_plus1"] == -(1 << 63) + 2
+
+
+def test_compare_on(harness_out):
+    o = harness_out
+    ctrl = (bit("CTRL", "EN") | fv("CTRL", "FUNC", "x1a") | fv("CTRL", "RANGE", "modulo")
+            | fv("CTRL", "FILTER_LEN", 9))
+    assert (o["cmp.COMPARE_HI"], o["cmp.COMPARE_LO"]) == (3, 0x10)
+    assert o["cmp.CTRL"] == ctrl | bit("CTRL", "CMP_EN"), "CMP_EN not set, or CTRL's fields lost"
+    assert o["cmp.IRQ_EN"] == bit("EVENTS", "INDEX") | bit("EVENTS", "CMP")
+    assert o["cmp.EVENTS"] == bit("EVENTS", "CMP")
 
 
 def test_homing_and_index_interrupt(harness_out):
