@@ -49,7 +49,7 @@ def main(argv: list[str] | None = None) -> int:
     kernel.overlay(tree)
     obj = kernel.configure(tree)
     kernel.build(tree, obj, args.jobs)
-    kernel._say("checkpatch.pl --strict and W=1 on the driver and the bridge")
+    kernel.say("checkpatch.pl --strict and W=1 on the driver and the bridge")
     found = kernel.checkpatch_findings(tree)
     results.append((not found, "checkpatch --strict: " + ("clean" if not found else
                                                            "; ".join(found))))
@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     present = None
     if rtl_version < WANT_VERSION and rtl_version >> 8 == WANT_VERSION >> 8:
         present = 0x5145_0000 | WANT_VERSION
-        kernel._say(f"the RTL reports register map {rtl_version >> 8}.{rtl_version & 0xff}; "
+        kernel.say(f"the RTL reports register map {rtl_version >> 8}.{rtl_version & 0xff}; "
                     f"the model servers answer ID reads with {present:#010x} until the RTL "
                     "reports 1.2")
     todo = [b for b in boots(present) if not args.boot or b.name in args.boot]
@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     servers = {b.build.name: model.build(b.build, args.jobs) for b in todo}
     dts_files = []
     for b in todo:
-        kernel._say(f"boot {b.name}: {b.mode} test against {b.build.name}"
+        kernel.say(f"boot {b.name}: {b.mode} test against {b.build.name}"
                     + ("" if b.irq else ", no interrupt"))
         out = boot.run(b, linux, servers[b.build.name], dtc, module, init)
         dts_files.append(kernel.WORK / "boots" / b.name / "test.dts")
@@ -83,10 +83,10 @@ def main(argv: list[str] | None = None) -> int:
             out.results.append((False, "the init did not finish (see "
                                 f"build/linux/boots/{b.name}/console.log)"))
         good = sum(r[0] for r in out.results)
-        kernel._say(f"boot {b.name}: {good} passed, {len(out.results) - good} failed "
+        kernel.say(f"boot {b.name}: {good} passed, {len(out.results) - good} failed "
                     f"({out.seconds:.1f} s)")
         results += [(ok, f"{b.name}: {what}") for ok, what in out.results]
-    kernel._say("devicetree binding: dtschema")
+    kernel.say("devicetree binding: dtschema")
     results += binding.check(tree, dtc, dts_files)
 
     bad = [what for ok, what in results if not ok]

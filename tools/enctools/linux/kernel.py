@@ -17,7 +17,6 @@ import os
 import re
 import shutil
 import subprocess
-import tarfile
 import time
 from pathlib import Path
 
@@ -59,7 +58,7 @@ class KernelError(SystemExit):
     pass
 
 
-def _say(msg: str) -> None:
+def say(msg: str) -> None:
     print(f"linux-test: {msg}", flush=True)
 
 
@@ -81,7 +80,7 @@ def source_tree() -> Path:
     tree = SRC_PARENT / name
     if stamp.exists() and stamp.read_text() == stamp_text and (tree / "Makefile").exists():
         return tree
-    _say(f"extracting {tb} into {tree} (once)")
+    say(f"extracting {tb} into {tree} (once)")
     if SRC_PARENT.exists():
         shutil.rmtree(SRC_PARENT)
     SRC_PARENT.mkdir(parents=True)
@@ -152,12 +151,11 @@ def configure(tree: Path) -> Path:
     obj = WORK / f"obj-{config_key(tree)}"
     if (obj / ".config").exists() and (obj / ".config-ok").exists():
         return obj
-    _say(f"configuring the kernel in {obj} (tinyconfig + {CONFIG_FRAGMENT.name})")
+    say(f"configuring the kernel in {obj} (tinyconfig + {CONFIG_FRAGMENT.name})")
     obj.mkdir(parents=True, exist_ok=True)
-    for step in (["tinyconfig"],):
-        res = _make(tree, obj, *step)
-        if res.returncode:
-            raise KernelError(f"linux-test: make tinyconfig failed:\n{res.stderr[-2000:]}")
+    res = _make(tree, obj, "tinyconfig")
+    if res.returncode:
+        raise KernelError(f"linux-test: make tinyconfig failed:\n{res.stderr[-2000:]}")
     res = subprocess.run([str(tree / "scripts/kconfig/merge_config.sh"), "-m", "-O", str(obj),
                           str(obj / ".config"), str(CONFIG_FRAGMENT)],
                          capture_output=True, text=True, cwd=tree,
@@ -180,7 +178,7 @@ def configure(tree: Path) -> Path:
 def build(tree: Path, obj: Path, jobs: int) -> Path:
     """Build the UML kernel and its modules; the path of the `linux` binary."""
     cold = not (obj / "linux").exists()
-    _say("building the UML kernel" + (" (a cold build: about 2 minutes on 2 cores)"
+    say("building the UML kernel" + (" (a cold build: about 2 minutes on 2 cores)"
                                       if cold else ""))
     t0 = time.monotonic()
     log = obj / "build.log"
@@ -188,7 +186,7 @@ def build(tree: Path, obj: Path, jobs: int) -> Path:
     if res.returncode:
         tail = "\n".join((res.stdout + res.stderr).splitlines()[-30:])
         raise KernelError(f"linux-test: the kernel build failed ({log}):\n{tail}")
-    _say(f"kernel built in {time.monotonic() - t0:.0f} s")
+    say(f"kernel built in {time.monotonic() - t0:.0f} s")
     return obj / "linux"
 
 

@@ -5,6 +5,7 @@ Verilator model of enc_qei_wb, one build per parameter set, in build/linux/model
 from __future__ import annotations
 
 import math
+import os
 import subprocess
 import time
 from dataclasses import dataclass, field
@@ -13,7 +14,7 @@ from pathlib import Path
 from .. import core
 from ..paths import TOP
 from ..toolenv import simulator_env, tool_path
-from .kernel import LINUX_SW, WORK
+from .kernel import LINUX_SW, WORK, say
 
 SERVER_SRC = LINUX_SW / "model-server" / "enc_qei_server.cpp"
 
@@ -33,10 +34,6 @@ class Build:
         return 8 + math.ceil(math.log2(self.channels)) if self.channels > 1 else 8
 
 
-def _say(msg: str) -> None:
-    print(f"linux-test: {msg}", flush=True)
-
-
 def build(b: Build, jobs: int) -> Path:
     """The server binary of build ``b`` (Verilator compiles it when a source changed)."""
     out = WORK / f"model-{b.name}"
@@ -48,7 +45,7 @@ def build(b: Build, jobs: int) -> Path:
     if (exe.exists() and stamp.exists() and stamp.read_text() == params_text
             and all(p.stat().st_mtime <= exe.stat().st_mtime for p in inputs)):
         return exe
-    _say(f"building the model server {b.name} ({', '.join(f'{k} {v}' for k, v in b.params.items())})")
+    say(f"building the model server {b.name} ({', '.join(f'{k} {v}' for k, v in b.params.items())})")
     t0 = time.monotonic()
     out.mkdir(parents=True, exist_ok=True)
     gparams = [f"-G{k}={v}" for k, v in b.params.items()] + [f"-GADDR_W={b.addr_w}"]
@@ -58,7 +55,7 @@ def build(b: Build, jobs: int) -> Path:
            *[f"-I{d}" for d in core.include_dirs()],
            "-CFLAGS", f"-O1 -I{LINUX_SW} -DENC_QEI_ADDR_W={b.addr_w}",
            str(TOP / "rtl" / "lint_waivers.vlt"), *map(str, sources), str(SERVER_SRC)]
-    env = {**__import__("os").environ, **simulator_env(), "PATH": tool_path()}
+    env = {**os.environ, **simulator_env(), "PATH": tool_path()}
     res = subprocess.run(cmd, capture_output=True, text=True, env=env)
     (out / "build.log").write_text(res.stdout + res.stderr)
     if res.returncode or not exe.exists():
@@ -66,5 +63,5 @@ def build(b: Build, jobs: int) -> Path:
         raise SystemExit(f"linux-test: the model server {b.name} did not build "
                          f"({out / 'build.log'}):\n{tail}")
     stamp.write_text(params_text)
-    _say(f"model server {b.name} built in {time.monotonic() - t0:.0f} s")
+    say(f"model server {b.name} built in {time.monotonic() - t0:.0f} s")
     return exe
