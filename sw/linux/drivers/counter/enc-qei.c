@@ -848,12 +848,9 @@ static int enc_qei_snapshot_read(struct counter_device *counter, u8 *val)
 
 static int enc_qei_snapshot_write(struct counter_device *counter, u8 val)
 {
-	struct enc_qei_priv *priv = counter_priv(counter);
-
 	if (val)
-		enc_qei_write(priv, 0, ENC_QEI_GSNAP_CTRL,
-			      enc_qei_read(priv, 0, ENC_QEI_GSNAP_CTRL) |
-			      ENC_QEI_GSNAP_CTRL_CMD);
+		enc_qei_update(counter_priv(counter), 0, ENC_QEI_GSNAP_CTRL,
+			       ENC_QEI_GSNAP_CTRL_CMD, ENC_QEI_GSNAP_CTRL_CMD);
 	return 0;
 }
 
