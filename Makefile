@@ -6,6 +6,7 @@ SHELL      := /bin/bash
 VENV       := .venv
 STAMP      := $(VENV)/.requirements-installed
 SOC_STAMP  := $(VENV)/.soc-installed
+LINUX_STAMP := $(VENV)/.linux-installed
 PY         := $(VENV)/bin/python
 SIM        ?= icarus
 JOBS       ?= 2
@@ -28,7 +29,7 @@ SIM_OR_AUTO = $(if $(filter command line,$(origin SIM)),$(SIM),auto)
 
 .DEFAULT_GOAL := help
 
-.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc soc-sim soc-bitstream
+.PHONY: help venv demo waves test lint clean synth bitstream sweep formal mutate regs velocity package-check fusesoc soc-sim soc-bitstream linux-test
 
 help: ## list the targets
 	@echo "HEDS-5000 encoder-interface IP -- make targets:"
@@ -43,6 +44,9 @@ venv: $(STAMP) ## create .venv from requirements.txt (done automatically by ever
 
 $(SOC_STAMP): $(STAMP) requirements-soc.txt scripts/bootstrap.sh
 	@bash scripts/bootstrap.sh --soc
+
+$(LINUX_STAMP): $(STAMP) requirements-linux.txt scripts/bootstrap.sh
+	@bash scripts/bootstrap.sh --linux
 
 demo: $(STAMP) ## the main job: a modeled HEDS-5000 drives every circuit (RPM= TEMP_C= CLK_HZ= SEED=)
 	@$(PY) scripts/demo.py --rpm "$(RPM)" --temp-c "$(TEMP_C)" --clk-hz "$(CLK_HZ)" --seed "$(SEED)" --sim $(SIM_OR_AUTO)
@@ -88,6 +92,9 @@ soc-sim: $(SOC_STAMP) ## LiteX SoC (VexRiscv + enc_qei, Verilator) running sw/so
 soc-bitstream: $(SOC_STAMP) ## the LiteX SoC with enc_qei on a board through Yosys/nextpnr (BOARD=icebreaker|colorlight_i5); doc/results/soc_bitstream.md
 	@case "$(BOARD)" in icebreaker|colorlight_i5) ;; *) echo "make soc-bitstream: give BOARD=icebreaker or BOARD=colorlight_i5" >&2; exit 2;; esac
 	$(PY) scripts/soc_bitstream.py --board $(BOARD)
+
+linux-test: $(LINUX_STAMP) ## the enc-qei Linux counter driver in User-Mode Linux against the RTL (Verilator), checkpatch --strict, W=1, dt-validate
+	$(PY) scripts/linux_test.py --jobs $(JOBS)
 
 package-check: $(STAMP) ## pip-install python/ (cocotbext-quadrature) into a fresh venv and run its example outside tb/
 	@bash scripts/check_package.sh

@@ -71,6 +71,7 @@ module enc_qei_core_formal #(
     input wire [COUNT_W-1:0] preset,
     input wire [COUNT_W-1:0] ceiling,
     input wire [COUNT_W-1:0] compare,
+    input wire               cmp_en,
     input wire [1:0]         idx_action,
     input wire               idx_oneshot,
     input wire               idx_edge,
@@ -115,6 +116,7 @@ module enc_qei_core_formal #(
       .preset        (preset),
       .ceiling       (ceiling),
       .compare       (compare),
+      .cmp_en        (cmp_en),
       .idx_action    (idx_action),
       .idx_oneshot   (idx_oneshot),
       .idx_edge      (idx_edge),
@@ -401,7 +403,7 @@ module enc_qei_core_formal #(
       f_stopped <= f_stop_d;
       if (f_su | f_sd) f_dir <= f_su;
       f_upd_q   <= f_load | f_took;  // the count was set (changed or reloaded) at this edge
-      f_cmp     <= f_upd_q & (f_count == compare);
+      f_cmp     <= cmp_en & f_upd_q & (f_count == compare);
     end
   end
 

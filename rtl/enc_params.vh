@@ -46,6 +46,6 @@
 // The least byte-address width that holds CHANNELS pages of 256 bytes (the default of ADDR_W)
 `define ENC_QEI_ADDR_W(CH) (((CH) > 8) ? 12 : (((CH) > 4) ? 11 : (((CH) > 2) ? 10 : (((CH) > 1) ? 9 : (8)))))
 // One channel's register bundles (rtl/enc_qei_chan_fields.vh): reg2hw and hw2reg widths
-`define ENC_QEI_R2H_CH_W 402
+`define ENC_QEI_R2H_CH_W 403
 `define ENC_QEI_H2R_CH_W 550
 `endif

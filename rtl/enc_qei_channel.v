@@ -137,6 +137,7 @@ module enc_qei_channel #(
       .preset       (r2h_preset[COUNT_W-1:0]),
       .ceiling      (r2h_ceiling[COUNT_W-1:0]),
       .compare      (r2h_compare[COUNT_W-1:0]),
+      .cmp_en       (r2h_ctrl_cmp_en),
       .idx_action   (r2h_index_ctrl_action),
       .idx_oneshot  (r2h_index_ctrl_oneshot),
       .idx_edge     (r2h_index_ctrl_edge),
@@ -179,6 +180,10 @@ module enc_qei_channel #(
       .cmp_out      (cmp_out)
   );
 
+  // (the core's applied steps are for its proofs: the timing unit and the edge FIFO count the
+  // function's steps, the motion, whatever loads and the range do to the count)
+  wire unused_applied = &{1'b0, applied_up, applied_dn};
+
   assign h2r_count           = zext_count(count_q);
   assign h2r_index_latch     = zext_count(idx_latch);
   assign h2r_probe_latch     = zext_count(probe_latch);
@@ -220,9 +225,8 @@ module enc_qei_channel #(
           .tick           (tick),
           .edge_any       (edge_any),
           .edge_a_rise    (edge_a_rise),
-          .step           (step_up | step_dn),
-          .applied_up     (applied_up),
-          .applied_dn     (applied_dn),
+          .step_up        (step_up),
+          .step_dn        (step_dn),
           .dir_change     (ev_dir_change),
           .count          (count_q),
           .snap_req       (snap_own | gsnap),
@@ -251,7 +255,7 @@ module enc_qei_channel #(
       assign h2r_snap_edge_time = zext_ts(snap_edge_time);
       assign h2r_period         = zext_ts(period);
     end else begin : g_no_timing
-      wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn, applied_up, applied_dn,
+      wire unused_timing = &{1'b0, edge_any, edge_a_rise, step_up, step_dn,
                              snap_in, tick, gsnap};
       assign h2r_snap_count             = 64'd0;
       assign h2r_snap_time              = 32'd0;

@@ -52,6 +52,7 @@ module enc_qei_core #(
     input  wire [COUNT_W-1:0] preset,
     input  wire [COUNT_W-1:0] ceiling,
     input  wire [COUNT_W-1:0] compare,
+    input  wire               cmp_en,         // CTRL.CMP_EN: compare on
     input  wire [1:0]         idx_action,
     input  wire               idx_oneshot,
     input  wire               idx_edge,       // 0 rising, 1 falling
@@ -666,7 +667,7 @@ module enc_qei_core #(
     if (rst) begin
       cmp_q <= 1'b0;
     end else begin
-      cmp_q <= (RANGE != 0) & upd_q & (count_q == compare);
+      cmp_q <= (RANGE != 0) & cmp_en & upd_q & (count_q == compare);
     end
   end
 

@@ -43,7 +43,7 @@ module enc_qei_regs #(
     output wire [50:0] reg2hw_g,  // global registers to the hardware
     // verilator lint_off UNUSEDSIGNAL
     input  wire [110:0] hw2reg_g,  // hardware to the global registers
-    output wire [CHANNELS*402-1:0] reg2hw_ch,  // channel k: bits [k*402 +: 402]
+    output wire [CHANNELS*403-1:0] reg2hw_ch,  // channel k: bits [k*403 +: 403]
     input  wire [CHANNELS*550-1:0] hw2reg_ch   // channel k: bits [k*550 +: 550]
     // verilator lint_on UNUSEDSIGNAL
 );
@@ -233,11 +233,11 @@ module enc_qei_regs #(
       wire [36:0] wr_c = wr_c_q & {37{page_hit[ch]}};  // writes to this page
       wire [36:0] rd_c = rd_c_q & {37{page_hit[ch]}};  // reads of this page
       // verilator lint_on UNUSEDSIGNAL
-      wire [401:0] r2h;
+      wire [402:0] r2h;
       // verilator lint_off UNUSEDSIGNAL
       wire [549:0] h2r = hw2reg_ch[ch*550 +: 550];  // (the unused bits of gapped live registers: EFIFO_ENTRY)
       // verilator lint_on UNUSEDSIGNAL
-      assign reg2hw_ch[ch*402 +: 402] = r2h;
+      assign reg2hw_ch[ch*403 +: 403] = r2h;
 
       reg  [31:0] count_hi_latch_q;  // COUNT_HI: the high word latched by a COUNT_LO read
       reg  [31:0] count_hi_stage_q;  // the word a COUNT_HI write staged
@@ -293,6 +293,16 @@ module enc_qei_regs #(
       end
       assign r2h[4] = ctrl_inv_z_q;
 
+      reg ctrl_cmp_en_q;  // CTRL.CMP_EN
+      always @(posedge clk) begin
+        if (rst) begin
+          ctrl_cmp_en_q <= 1'h0;
+        end else if (wr_c[0]) begin
+          if (wstrb_q[0]) ctrl_cmp_en_q <= wdata_q[5:5];
+        end
+      end
+      assign r2h[5] = ((RANGE != 0) ? ctrl_cmp_en_q : 1'd0);
+
       reg [3:0] ctrl_func_q;  // CTRL.FUNC
       always @(posedge clk) begin
         if (rst) begin
@@ -301,7 +311,7 @@ module enc_qei_regs #(
           if (wstrb_q[1]) ctrl_func_q[3:0] <= wdata_q[11:8];
         end
       end
-      assign r2h[8:5] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
+      assign r2h[9:6] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);
 
       reg [1:0] ctrl_range_q;  // CTRL.RANGE
       always @(posedge clk) begin
@@ -311,7 +321,7 @@ module enc_qei_regs #(
           if (wstrb_q[1]) ctrl_range_q[1:0] <= wdata_q[13:12];
         end
       end
-      assign r2h[10:9] = ((RANGE != 0) ? ctrl_range_q : 2'd0);
+      assign r2h[11:10] = ((RANGE != 0) ? ctrl_range_q : 2'd0);
 
       reg [4:0] ctrl_filter_len_q;  // CTRL.FILTER_LEN
       always @(posedge clk) begin
@@ -321,12 +331,12 @@ module enc_qei_regs #(
           if (wstrb_q[2]) ctrl_filter_len_q[4:0] <= wdata_q[20:16];
         end
       end
-      assign r2h[15:11] = ctrl_filter_len_q;
+      assign r2h[16:12] = ctrl_filter_len_q;
 
       // COUNT_LO: a read latches the high word; a write loads {staged word, this word}
       wire [31:0] count_lo_word = (h2r[39:8] & ~(bmask[31:0] & SZ_COUNT_LO[31:0])) | (wdata_q & bmask[31:0] & SZ_COUNT_LO[31:0]);
-      assign r2h[16] = wr_c[2] & (|wstrb_q);
-      assign r2h[80:17] = {count_hi_stage_q, count_lo_word};
+      assign r2h[17] = wr_c[2] & (|wstrb_q);
+      assign r2h[81:18] = {count_hi_stage_q, count_lo_word};
 
       // COUNT_HI: the high word latched by the last COUNT_LO read; the staged word
       always @(posedge clk) begin
@@ -355,7 +365,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) preset_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
-      assign r2h[112:81] = preset_lo_value_q;
+      assign r2h[113:82] = preset_lo_value_q;
 
       reg [31:0] preset_hi_value_q;  // PRESET_HI.VALUE
       always @(posedge clk) begin
@@ -368,7 +378,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) preset_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
-      assign r2h[144:113] = preset_hi_value_q;
+      assign r2h[145:114] = preset_hi_value_q;
 
       reg [31:0] ceiling_lo_value_q;  // CEILING_LO.VALUE
       always @(posedge clk) begin
@@ -381,7 +391,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) ceiling_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
-      assign r2h[176:145] = ((RANGE != 0) ? ceiling_lo_value_q : 32'd0);
+      assign r2h[177:146] = ((RANGE != 0) ? ceiling_lo_value_q : 32'd0);
 
       reg [31:0] ceiling_hi_value_q;  // CEILING_HI.VALUE
       always @(posedge clk) begin
@@ -394,7 +404,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) ceiling_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
-      assign r2h[208:177] = ((RANGE != 0) ? ceiling_hi_value_q : 32'd0);
+      assign r2h[209:178] = ((RANGE != 0) ? ceiling_hi_value_q : 32'd0);
 
       reg [31:0] compare_lo_value_q;  // COMPARE_LO.VALUE
       always @(posedge clk) begin
@@ -407,7 +417,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) compare_lo_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_LO[31:24];
         end
       end
-      assign r2h[240:209] = ((RANGE != 0) ? compare_lo_value_q : 32'd0);
+      assign r2h[241:210] = ((RANGE != 0) ? compare_lo_value_q : 32'd0);
 
       reg [31:0] compare_hi_value_q;  // COMPARE_HI.VALUE
       always @(posedge clk) begin
@@ -420,7 +430,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) compare_hi_value_q[31:24] <= wdata_q[31:24] & SZ_COUNT_HI[31:24];
         end
       end
-      assign r2h[272:241] = ((RANGE != 0) ? compare_hi_value_q : 32'd0);
+      assign r2h[273:242] = ((RANGE != 0) ? compare_hi_value_q : 32'd0);
 
       reg [1:0] index_ctrl_action_q;  // INDEX_CTRL.ACTION
       always @(posedge clk) begin
@@ -430,7 +440,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_action_q[1:0] <= wdata_q[1:0];
         end
       end
-      assign r2h[274:273] = index_ctrl_action_q;
+      assign r2h[275:274] = index_ctrl_action_q;
 
       reg index_ctrl_oneshot_q;  // INDEX_CTRL.ONESHOT
       always @(posedge clk) begin
@@ -440,7 +450,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_oneshot_q <= wdata_q[2:2];
         end
       end
-      assign r2h[275] = index_ctrl_oneshot_q;
+      assign r2h[276] = index_ctrl_oneshot_q;
 
       reg index_ctrl_edge_q;  // INDEX_CTRL.EDGE
       always @(posedge clk) begin
@@ -450,7 +460,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_edge_q <= wdata_q[3:3];
         end
       end
-      assign r2h[276] = index_ctrl_edge_q;
+      assign r2h[277] = index_ctrl_edge_q;
 
       reg index_ctrl_gate_en_q;  // INDEX_CTRL.GATE_EN
       always @(posedge clk) begin
@@ -460,7 +470,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_gate_en_q <= wdata_q[4:4];
         end
       end
-      assign r2h[277] = index_ctrl_gate_en_q;
+      assign r2h[278] = index_ctrl_gate_en_q;
 
       reg index_ctrl_gate_a_q;  // INDEX_CTRL.GATE_A
       always @(posedge clk) begin
@@ -470,7 +480,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_gate_a_q <= wdata_q[5:5];
         end
       end
-      assign r2h[278] = index_ctrl_gate_a_q;
+      assign r2h[279] = index_ctrl_gate_a_q;
 
       reg index_ctrl_gate_b_q;  // INDEX_CTRL.GATE_B
       always @(posedge clk) begin
@@ -480,7 +490,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) index_ctrl_gate_b_q <= wdata_q[6:6];
         end
       end
-      assign r2h[279] = index_ctrl_gate_b_q;
+      assign r2h[280] = index_ctrl_gate_b_q;
 
       reg index_ctrl_arm_q;  // INDEX_CTRL.ARM
       always @(posedge clk) begin
@@ -492,7 +502,7 @@ module enc_qei_regs #(
           index_ctrl_arm_q <= 1'd0;
         end
       end
-      assign r2h[280] = index_ctrl_arm_q;
+      assign r2h[281] = index_ctrl_arm_q;
 
       reg probe_ctrl_en_q;  // PROBE_CTRL.EN
       always @(posedge clk) begin
@@ -504,7 +514,7 @@ module enc_qei_regs #(
           probe_ctrl_en_q <= 1'd0;
         end
       end
-      assign r2h[281] = ((PROBE != 0) ? probe_ctrl_en_q : 1'd0);
+      assign r2h[282] = ((PROBE != 0) ? probe_ctrl_en_q : 1'd0);
 
       reg probe_ctrl_edge_q;  // PROBE_CTRL.EDGE
       always @(posedge clk) begin
@@ -514,7 +524,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) probe_ctrl_edge_q <= wdata_q[1:1];
         end
       end
-      assign r2h[282] = ((PROBE != 0) ? probe_ctrl_edge_q : 1'd0);
+      assign r2h[283] = ((PROBE != 0) ? probe_ctrl_edge_q : 1'd0);
 
       reg probe_ctrl_once_q;  // PROBE_CTRL.ONCE
       always @(posedge clk) begin
@@ -524,7 +534,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) probe_ctrl_once_q <= wdata_q[2:2];
         end
       end
-      assign r2h[283] = ((PROBE != 0) ? probe_ctrl_once_q : 1'd0);
+      assign r2h[284] = ((PROBE != 0) ? probe_ctrl_once_q : 1'd0);
 
       reg events_overflow_q;  // EVENTS.OVERFLOW
       always @(posedge clk) begin
@@ -534,7 +544,7 @@ module enc_qei_regs #(
           events_overflow_q <= (events_overflow_q & ~({1{wr_c[17]}} & wdata_q[0:0] & bmask[0:0])) | h2r[234];
         end
       end
-      assign r2h[284] = events_overflow_q;
+      assign r2h[285] = events_overflow_q;
 
       reg events_underflow_q;  // EVENTS.UNDERFLOW
       always @(posedge clk) begin
@@ -544,7 +554,7 @@ module enc_qei_regs #(
           events_underflow_q <= (events_underflow_q & ~({1{wr_c[17]}} & wdata_q[1:1] & bmask[1:1])) | h2r[235];
         end
       end
-      assign r2h[285] = events_underflow_q;
+      assign r2h[286] = events_underflow_q;
 
       reg events_index_q;  // EVENTS.INDEX
       always @(posedge clk) begin
@@ -554,7 +564,7 @@ module enc_qei_regs #(
           events_index_q <= (events_index_q & ~({1{wr_c[17]}} & wdata_q[2:2] & bmask[2:2])) | h2r[236];
         end
       end
-      assign r2h[286] = events_index_q;
+      assign r2h[287] = events_index_q;
 
       reg events_probe_q;  // EVENTS.PROBE
       always @(posedge clk) begin
@@ -564,7 +574,7 @@ module enc_qei_regs #(
           events_probe_q <= (events_probe_q & ~({1{wr_c[17]}} & wdata_q[3:3] & bmask[3:3])) | h2r[237];
         end
       end
-      assign r2h[287] = ((PROBE != 0) ? events_probe_q : 1'd0);
+      assign r2h[288] = ((PROBE != 0) ? events_probe_q : 1'd0);
 
       reg events_cmp_q;  // EVENTS.CMP
       always @(posedge clk) begin
@@ -574,7 +584,7 @@ module enc_qei_regs #(
           events_cmp_q <= (events_cmp_q & ~({1{wr_c[17]}} & wdata_q[4:4] & bmask[4:4])) | h2r[238];
         end
       end
-      assign r2h[288] = ((RANGE != 0) ? events_cmp_q : 1'd0);
+      assign r2h[289] = ((RANGE != 0) ? events_cmp_q : 1'd0);
 
       reg events_qerr_q;  // EVENTS.QERR
       always @(posedge clk) begin
@@ -584,7 +594,7 @@ module enc_qei_regs #(
           events_qerr_q <= (events_qerr_q & ~({1{wr_c[17]}} & wdata_q[5:5] & bmask[5:5])) | h2r[239];
         end
       end
-      assign r2h[289] = events_qerr_q;
+      assign r2h[290] = events_qerr_q;
 
       reg events_glitch_q;  // EVENTS.GLITCH
       always @(posedge clk) begin
@@ -594,7 +604,7 @@ module enc_qei_regs #(
           events_glitch_q <= (events_glitch_q & ~({1{wr_c[17]}} & wdata_q[6:6] & bmask[6:6])) | h2r[240];
         end
       end
-      assign r2h[290] = events_glitch_q;
+      assign r2h[291] = events_glitch_q;
 
       reg events_dir_change_q;  // EVENTS.DIR_CHANGE
       always @(posedge clk) begin
@@ -604,7 +614,7 @@ module enc_qei_regs #(
           events_dir_change_q <= (events_dir_change_q & ~({1{wr_c[17]}} & wdata_q[7:7] & bmask[7:7])) | h2r[241];
         end
       end
-      assign r2h[291] = events_dir_change_q;
+      assign r2h[292] = events_dir_change_q;
 
       reg events_stall_q;  // EVENTS.STALL
       always @(posedge clk) begin
@@ -614,7 +624,7 @@ module enc_qei_regs #(
           events_stall_q <= (events_stall_q & ~({1{wr_c[17]}} & wdata_q[8:8] & bmask[8:8])) | h2r[242];
         end
       end
-      assign r2h[292] = ((PERIOD != 0) ? events_stall_q : 1'd0);
+      assign r2h[293] = ((PERIOD != 0) ? events_stall_q : 1'd0);
 
       reg events_snap_ready_q;  // EVENTS.SNAP_READY
       always @(posedge clk) begin
@@ -624,7 +634,7 @@ module enc_qei_regs #(
           events_snap_ready_q <= (events_snap_ready_q & ~({1{wr_c[17]}} & wdata_q[9:9] & bmask[9:9])) | h2r[243];
         end
       end
-      assign r2h[293] = ((TIMING != 0) ? events_snap_ready_q : 1'd0);
+      assign r2h[294] = ((TIMING != 0) ? events_snap_ready_q : 1'd0);
 
       reg events_period_ready_q;  // EVENTS.PERIOD_READY
       always @(posedge clk) begin
@@ -634,7 +644,7 @@ module enc_qei_regs #(
           events_period_ready_q <= (events_period_ready_q & ~({1{wr_c[17]}} & wdata_q[10:10] & bmask[10:10])) | h2r[244];
         end
       end
-      assign r2h[294] = ((PERIOD != 0) ? events_period_ready_q : 1'd0);
+      assign r2h[295] = ((PERIOD != 0) ? events_period_ready_q : 1'd0);
 
       reg events_period_ovf_q;  // EVENTS.PERIOD_OVF
       always @(posedge clk) begin
@@ -644,7 +654,7 @@ module enc_qei_regs #(
           events_period_ovf_q <= (events_period_ovf_q & ~({1{wr_c[17]}} & wdata_q[11:11] & bmask[11:11])) | h2r[245];
         end
       end
-      assign r2h[295] = ((PERIOD != 0) ? events_period_ovf_q : 1'd0);
+      assign r2h[296] = ((PERIOD != 0) ? events_period_ovf_q : 1'd0);
 
       reg events_efifo_thresh_q;  // EVENTS.EFIFO_THRESH
       always @(posedge clk) begin
@@ -654,7 +664,7 @@ module enc_qei_regs #(
           events_efifo_thresh_q <= (events_efifo_thresh_q & ~({1{wr_c[17]}} & wdata_q[12:12] & bmask[12:12])) | h2r[246];
         end
       end
-      assign r2h[296] = ((EFIFO != 0) ? events_efifo_thresh_q : 1'd0);
+      assign r2h[297] = ((EFIFO != 0) ? events_efifo_thresh_q : 1'd0);
 
       reg events_efifo_ovf_q;  // EVENTS.EFIFO_OVF
       always @(posedge clk) begin
@@ -664,7 +674,7 @@ module enc_qei_regs #(
           events_efifo_ovf_q <= (events_efifo_ovf_q & ~({1{wr_c[17]}} & wdata_q[13:13] & bmask[13:13])) | h2r[247];
         end
       end
-      assign r2h[297] = ((EFIFO != 0) ? events_efifo_ovf_q : 1'd0);
+      assign r2h[298] = ((EFIFO != 0) ? events_efifo_ovf_q : 1'd0);
 
       reg [13:0] irq_en_en_q;  // IRQ_EN.EN
       always @(posedge clk) begin
@@ -675,7 +685,7 @@ module enc_qei_regs #(
           if (wstrb_q[1]) irq_en_en_q[13:8] <= wdata_q[13:8];
         end
       end
-      assign r2h[311:298] = irq_en_en_q;
+      assign r2h[312:299] = irq_en_en_q;
 
       reg [15:0] qerr_count_value_q;  // QERR_COUNT.VALUE
       always @(posedge clk) begin
@@ -705,7 +715,7 @@ module enc_qei_regs #(
         else if (wr_c[21]) snap_ctrl_cmd_q <= wdata_q[0:0] & bmask[0:0];
         else snap_ctrl_cmd_q <= 1'd0;
       end
-      assign r2h[312] = ((TIMING != 0) ? snap_ctrl_cmd_q : 1'd0);
+      assign r2h[313] = ((TIMING != 0) ? snap_ctrl_cmd_q : 1'd0);
 
       reg snap_ctrl_in_en_q;  // SNAP_CTRL.IN_EN
       always @(posedge clk) begin
@@ -715,7 +725,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_in_en_q <= wdata_q[1:1];
         end
       end
-      assign r2h[313] = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
+      assign r2h[314] = ((TIMING != 0) ? snap_ctrl_in_en_q : 1'd0);
 
       reg snap_ctrl_period_en_q;  // SNAP_CTRL.PERIOD_EN
       always @(posedge clk) begin
@@ -725,7 +735,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_period_en_q <= wdata_q[2:2];
         end
       end
-      assign r2h[314] = ((PERIOD != 0) ? snap_ctrl_period_en_q : 1'd0);
+      assign r2h[315] = ((PERIOD != 0) ? snap_ctrl_period_en_q : 1'd0);
 
       reg snap_ctrl_edge_q;  // SNAP_CTRL.EDGE
       always @(posedge clk) begin
@@ -735,7 +745,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) snap_ctrl_edge_q <= wdata_q[3:3];
         end
       end
-      assign r2h[315] = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
+      assign r2h[316] = ((TIMING != 0) ? snap_ctrl_edge_q : 1'd0);
 
       reg [31:0] snap_period_value_q;  // SNAP_PERIOD.VALUE
       always @(posedge clk) begin
@@ -748,7 +758,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) snap_period_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
-      assign r2h[347:316] = ((PERIOD != 0) ? snap_period_value_q : 32'd0);
+      assign r2h[348:317] = ((PERIOD != 0) ? snap_period_value_q : 32'd0);
 
       reg period_ctrl_en_q;  // PERIOD_CTRL.EN
       always @(posedge clk) begin
@@ -758,7 +768,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) period_ctrl_en_q <= wdata_q[0:0];
         end
       end
-      assign r2h[348] = ((PERIOD != 0) ? period_ctrl_en_q : 1'd0);
+      assign r2h[349] = ((PERIOD != 0) ? period_ctrl_en_q : 1'd0);
 
       reg period_ctrl_edge_q;  // PERIOD_CTRL.EDGE
       always @(posedge clk) begin
@@ -768,7 +778,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) period_ctrl_edge_q <= wdata_q[1:1];
         end
       end
-      assign r2h[349] = ((PERIOD != 0) ? period_ctrl_edge_q : 1'd0);
+      assign r2h[350] = ((PERIOD != 0) ? period_ctrl_edge_q : 1'd0);
 
       reg [7:0] period_ctrl_n_q;  // PERIOD_CTRL.N
       always @(posedge clk) begin
@@ -778,7 +788,7 @@ module enc_qei_regs #(
           if (wstrb_q[1]) period_ctrl_n_q[7:0] <= wdata_q[15:8];
         end
       end
-      assign r2h[357:350] = ((PERIOD != 0) ? period_ctrl_n_q : 8'd0);
+      assign r2h[358:351] = ((PERIOD != 0) ? period_ctrl_n_q : 8'd0);
 
       reg [31:0] stall_timeout_value_q;  // STALL_TIMEOUT.VALUE
       always @(posedge clk) begin
@@ -791,7 +801,7 @@ module enc_qei_regs #(
           if (wstrb_q[3]) stall_timeout_value_q[31:24] <= wdata_q[31:24] & SZ_TS[31:24];
         end
       end
-      assign r2h[389:358] = ((PERIOD != 0) ? stall_timeout_value_q : 32'd0);
+      assign r2h[390:359] = ((PERIOD != 0) ? stall_timeout_value_q : 32'd0);
 
       reg efifo_ctrl_en_q;  // EFIFO_CTRL.EN
       always @(posedge clk) begin
@@ -801,7 +811,7 @@ module enc_qei_regs #(
           if (wstrb_q[0]) efifo_ctrl_en_q <= wdata_q[0:0];
         end
       end
-      assign r2h[390] = ((EFIFO != 0) ? efifo_ctrl_en_q : 1'd0);
+      assign r2h[391] = ((EFIFO != 0) ? efifo_ctrl_en_q : 1'd0);
 
       reg efifo_ctrl_clear_q;  // EFIFO_CTRL.CLEAR: one-clock pulse
       always @(posedge clk) begin
@@ -809,7 +819,7 @@ module enc_qei_regs #(
         else if (wr_c[32]) efifo_ctrl_clear_q <= wdata_q[1:1] & bmask[1:1];
         else efifo_ctrl_clear_q <= 1'd0;
       end
-      assign r2h[391] = ((EFIFO != 0) ? efifo_ctrl_clear_q : 1'd0);
+      assign r2h[392] = ((EFIFO != 0) ? efifo_ctrl_clear_q : 1'd0);
 
       reg [8:0] efifo_ctrl_thresh_q;  // EFIFO_CTRL.THRESH
       always @(posedge clk) begin
@@ -820,10 +830,10 @@ module enc_qei_regs #(
           if (wstrb_q[2]) efifo_ctrl_thresh_q[8:8] <= wdata_q[16:16];
         end
       end
-      assign r2h[400:392] = ((EFIFO != 0) ? efifo_ctrl_thresh_q : 9'd0);
+      assign r2h[401:393] = ((EFIFO != 0) ? efifo_ctrl_thresh_q : 9'd0);
 
       // EFIFO_ENTRY: a read of it is a strobe to the hardware (swacc: a read side effect)
-      assign r2h[401] = ((EFIFO != 0) ? rd_c[34] : 1'd0);
+      assign r2h[402] = ((EFIFO != 0) ? rd_c[34] : 1'd0);
 
       reg [15:0] efifo_lost_value_q;  // EFIFO_LOST.VALUE
       always @(posedge clk) begin
@@ -845,6 +855,7 @@ module enc_qei_regs #(
             rd[2:2] = rd[2:2] | ctrl_inv_a_q;  // CTRL.INV_A
             rd[3:3] = rd[3:3] | ctrl_inv_b_q;  // CTRL.INV_B
             rd[4:4] = rd[4:4] | ctrl_inv_z_q;  // CTRL.INV_Z
+            if (RANGE != 0) rd[5:5] = rd[5:5] | ctrl_cmp_en_q;  // CTRL.CMP_EN
             rd[11:8] = rd[11:8] | ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);  // CTRL.FUNC
             if (RANGE != 0) rd[13:12] = rd[13:12] | ctrl_range_q;  // CTRL.RANGE
             rd[20:16] = rd[20:16] | ctrl_filter_len_q;  // CTRL.FILTER_LEN
@@ -1010,6 +1021,7 @@ module enc_qei_regs #(
         f_view[2 +: 1] = ctrl_inv_a_q;  // CTRL.INV_A
         f_view[3 +: 1] = ctrl_inv_b_q;  // CTRL.INV_B
         f_view[4 +: 1] = ctrl_inv_z_q;  // CTRL.INV_Z
+        if (RANGE != 0) f_view[5 +: 1] = ctrl_cmp_en_q;  // CTRL.CMP_EN
         f_view[8 +: 4] = ((FIXED_FUNC >= 0) ? FIXED_FUNC[3:0] : ctrl_func_q);  // CTRL.FUNC
         if (RANGE != 0) f_view[12 +: 2] = ctrl_range_q;  // CTRL.RANGE
         f_view[16 +: 5] = ctrl_filter_len_q;  // CTRL.FILTER_LEN
@@ -1106,7 +1118,7 @@ module enc_qei_regs #(
   always @(*) begin
     rd_d = 32'd0;
     if (rd_g_q[0]) begin  // ID
-      rd_d[15:0] = rd_d[15:0] | 16'h101;  // ID.VERSION
+      rd_d[15:0] = rd_d[15:0] | 16'h102;  // ID.VERSION
       rd_d[31:16] = rd_d[31:16] | 16'h5145;  // ID.MAGIC
     end
     if (rd_g_q[1]) begin  // CAPS
@@ -1147,7 +1159,7 @@ module enc_qei_regs #(
   reg [255:0] f_view_g;
   always @(*) begin
     f_view_g = {256{1'b0}};
-    f_view_g[0 +: 16] = 16'h101;  // ID.VERSION
+    f_view_g[0 +: 16] = 16'h102;  // ID.VERSION
     f_view_g[16 +: 16] = 16'h5145;  // ID.MAGIC
     f_view_g[32 +: 8] = hw2reg_g[7:0];  // CAPS.COUNT_W
     f_view_g[40 +: 8] = hw2reg_g[15:8];  // CAPS.TS_W

@@ -14,11 +14,14 @@
 //   SNAP_COUNT      the count register now (count)
 //   SNAP_TIME       the timebase now
 //   SNAP_EDGE_TIME  the timestamp of the last edge of the selected type (this clock's included)
-//   SNAP_DELTA      the applied count steps since the previous snapshot (this clock's included)
-//   SNAP_EDGE_DELTA the applied steps between the previous snapshot's last selected edge and this
-//                   one's: `head` adds up, at each selected edge, the steps since the edge before
+//   SNAP_DELTA      the count function's steps since the previous snapshot (this clock's included)
+//   SNAP_EDGE_DELTA the steps between the previous snapshot's last selected edge and this one's:
+//                   `head` adds up, at each selected edge, the steps since the edge before
 //                   (`tail` plus the edge's own step), and restarts at each snapshot
-// Both deltas are 32-bit two's complement and wrap (2^31 steps between two snapshots).
+// Both deltas count the motion: every step of the count function while CTRL.EN = 1 (step_up /
+// step_dn), whatever a COUNT write, an index preset or the range does to the count, so that a
+// velocity across a preset or a range stop is the shaft's. They are 32-bit two's complement and
+// wrap (2^31 steps between two snapshots).
 // Period: while period_en, every period_n (0 acts as 1) selected edges the ticks since the edge
 // that started the measurement go to PERIOD (timebase(end) - timebase(start)); the end edge starts
 // the next one. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
@@ -41,9 +44,8 @@ module enc_qei_timing #(
     // from the core, in the clock of the edge / step
     input  wire               edge_any,        // a valid quadrature transition
     input  wire               edge_a_rise,     // a rising edge of A
-    input  wire               step,            // a step of the count function (applied or not)
-    input  wire               applied_up,      // the count took a +1 step
-    input  wire               applied_dn,      // the count took a -1 step
+    input  wire               step_up,         // a +1 step of the count function (CTRL.EN = 1)
+    input  wire               step_dn,         // a -1 step (never with step_up)
     input  wire               dir_change,      // a step against the previous step's direction
     input  wire [COUNT_W-1:0] count,           // the count register
     // snapshot
@@ -93,24 +95,24 @@ module enc_qei_timing #(
   end
 
   (* keep *) always @(posedge clk) begin
-    mv_d_q <= ~rst & (applied_up | applied_dn);
-    dn_d_q <= ~rst & applied_dn;
+    mv_d_q <= ~rst & (step_up | step_dn);
+    dn_d_q <= ~rst & step_dn;
   end
 
   (* keep *) always @(posedge clk) begin
-    mv_t_q <= ~rst & (applied_up | applied_dn);
-    dn_t_q <= ~rst & applied_dn;
+    mv_t_q <= ~rst & (step_up | step_dn);
+    dn_t_q <= ~rst & step_dn;
   end
 
   (* keep *) always @(posedge clk) begin
-    mv_a_q <= ~rst & (applied_up | applied_dn);
-    dn_a_q <= ~rst & applied_dn;
+    mv_a_q <= ~rst & (step_up | step_dn);
+    dn_a_q <= ~rst & step_dn;
   end
 
   // ---- snapshot ------------------------------------------------------------------------------------
   wire [TS_W-1:0] tb_q = timebase;
   wire        sel_snap  = sel_snap_q;
-  // +1, -1 or 0 (applied_up and applied_dn never come together): straight from registers into
+  // +1, -1 or 0 (step_up and step_dn never come together): straight from registers into
   // the adders' carry chains (Fmax)
   // x + 1, x - 1 or x (mv, dn: a step, down), by carry select: the low half's carry out picks the
   // high half with carry in 0 or 1 (two 16-bit chains side by side instead of one of 32; Fmax)
@@ -131,8 +133,8 @@ module enc_qei_timing #(
     end
   endfunction
 
-  reg  [31:0] delta_q;      // applied steps since the previous snapshot
-  reg  [31:0] tail_q;       // applied steps since the last selected edge
+  reg  [31:0] delta_q;      // steps since the previous snapshot
+  reg  [31:0] tail_q;       // steps since the last selected edge
   reg  [31:0] head_q;       // steps from the previous snapshot's last selected edge to the last one
   reg  [31:0] acc_q;        // head_q + tail_q, kept by its own adder (no adder chain for Fmax)
   reg  [TS_W-1:0] last_edge_q;  // timestamp of the last selected edge
@@ -193,7 +195,7 @@ module enc_qei_timing #(
         dir_change_q <= 1'b0;
       end else begin
         sel_per_q    <= period_edge ? edge_a_rise : edge_any;
-        step_q       <= step;
+        step_q       <= step_up | step_dn;
         dir_change_q <= dir_change;
       end
     end
@@ -348,7 +350,7 @@ module enc_qei_timing #(
     assign ev_period_ovf   = saturate & ~ovf_q;
     assign ev_stall        = stall_hit;
     end else begin : g_no_period
-      wire unused_period = &{1'b0, tick, step, dir_change, period_en, period_edge, period_n,
+      wire unused_period = &{1'b0, tick, dir_change, period_en, period_edge, period_n,
                              stall_timeout};
       assign period          = TS_ZERO;
       assign period_ovf_flag = 1'b0;

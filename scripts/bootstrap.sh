@@ -6,8 +6,40 @@
 # message names the package to install. Called by the Makefile; safe to run again.
 # `bootstrap.sh --soc` (the soc targets, after the above) adds the LiteX SoC simulation: the RISC-V
 # cross compiler and the libraries of LiteX's simulator from Debian, requirements-soc.txt into .venv.
+# `bootstrap.sh --linux` (make linux-test) adds the kernel source and its build tools from Debian
+# (linux-source-6.1, flex, bison, bc, perl, cpp) and requirements-linux.txt (dtschema) into .venv.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+if [ "${1:-}" = "--linux" ]; then
+  linux_pkgs=()
+  compgen -G "/usr/src/linux-source-6.1*.tar.xz" >/dev/null || linux_pkgs+=(linux-source-6.1)
+  command -v flex  >/dev/null 2>&1 || linux_pkgs+=(flex)
+  command -v bison >/dev/null 2>&1 || linux_pkgs+=(bison)
+  command -v bc    >/dev/null 2>&1 || linux_pkgs+=(bc)
+  command -v perl  >/dev/null 2>&1 || linux_pkgs+=(perl)
+  command -v cpp   >/dev/null 2>&1 || linux_pkgs+=(cpp)
+  command -v xz    >/dev/null 2>&1 || linux_pkgs+=(xz-utils)
+  [ -e /usr/include/linux/counter.h ] || linux_pkgs+=(linux-libc-dev)
+  { [ -e /usr/lib/x86_64-linux-gnu/libc.a ] || [ -e /usr/lib/libc.a ]; } || linux_pkgs+=(libc6-dev)
+  if [ ${#linux_pkgs[@]} -gt 0 ]; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+      echo "bootstrap: installing ${linux_pkgs[*]} with apt-get (make linux-test)"
+      apt=(apt-get -o APT::Sandbox::User=root)
+      if ! { "${apt[@]}" update -qq && DEBIAN_FRONTEND=noninteractive "${apt[@]}" install -y -qq "${linux_pkgs[@]}"; } >/tmp/bootstrap-apt-linux.log 2>&1; then
+        echo "bootstrap: apt-get could not install ${linux_pkgs[*]} (see /tmp/bootstrap-apt-linux.log); install them and run again" >&2
+        exit 1
+      fi
+    else
+      echo "bootstrap: missing system packages for make linux-test: ${linux_pkgs[*]} (install them, e.g. 'sudo apt-get install ${linux_pkgs[*]}')" >&2
+      exit 1
+    fi
+  fi
+  echo "bootstrap: installing requirements-linux.txt into .venv"
+  .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements-linux.txt
+  touch .venv/.linux-installed
+  exit 0
+fi
 
 if [ "${1:-}" = "--soc" ]; then
   soc_pkgs=()

@@ -8,15 +8,12 @@
  */
 #include "enc_qei_example.h"
 
-/* value placed into a field: (v << position) & mask */
-#define FIELD(reg_field, v) (((uint32_t)(v) << reg_field##_bp) & reg_field##_bm)
-
 uint32_t enc_qei_ctrl_word(uint32_t func, uint32_t range, uint32_t filter_len)
 {
-    return FIELD(ENC_QEI__CTRL__EN, 1u) |
-           FIELD(ENC_QEI__CTRL__FUNC, func) |
-           FIELD(ENC_QEI__CTRL__RANGE, range) |
-           FIELD(ENC_QEI__CTRL__FILTER_LEN, filter_len);
+    return ENC_QEI__CTRL__EN_bm |
+           ENC_QEI__CTRL__FUNC_SET(func) |
+           ENC_QEI__CTRL__RANGE_SET(range) |
+           ENC_QEI__CTRL__FILTER_LEN_SET(filter_len);
 }
 
 void enc_qei_setup_x4(volatile enc_qei_chan_t *q, uint32_t filter_len, uint32_t range, uint64_t ceiling)
@@ -25,7 +22,7 @@ void enc_qei_setup_x4(volatile enc_qei_chan_t *q, uint32_t filter_len, uint32_t 
     q->CEILING_HI = (uint32_t)(ceiling >> 32);
     q->CEILING_LO = (uint32_t)ceiling;
     /* a FUNC change re-references the decoder at the present state: nothing is counted for it */
-    q->CTRL = enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X4, range, filter_len);
+    q->CTRL = enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X4_VAL, range, filter_len);
     enc_qei_write_count(q, 0u);
     /* clear whatever is pending: write 1 to clear, every bit (bits without an event ignore it) */
     q->EVENTS = 0xFFFFFFFFu;
@@ -36,7 +33,7 @@ void enc_qei_setup_x4(volatile enc_qei_chan_t *q, uint32_t filter_len, uint32_t 
 
 unsigned enc_qei_count_width(volatile enc_qei_t *q)
 {
-    return (unsigned)((q->glb.CAPS & ENC_QEI__CAPS__COUNT_W_bm) >> ENC_QEI__CAPS__COUNT_W_bp);
+    return (unsigned)ENC_QEI__CAPS__COUNT_W_GET(q->glb.CAPS);
 }
 
 uint64_t enc_qei_combine64(uint32_t lo, uint32_t hi)
@@ -74,6 +71,17 @@ void enc_qei_write_count(volatile enc_qei_chan_t *q, uint64_t value)
     q->COUNT_LO = (uint32_t)value;         /* loads {staged HI, LO}, clears STATUS.STOPPED */
 }
 
+void enc_qei_compare_at(volatile enc_qei_chan_t *q, uint64_t value)
+{
+    q->COMPARE_HI = (uint32_t)(value >> 32);
+    q->COMPARE_LO = (uint32_t)value;
+    q->EVENTS = ENC_QEI__EVENTS__CMP_bm;
+    q->IRQ_EN = q->IRQ_EN | ENC_QEI__EVENTS__CMP_bm;
+    /* last: compare on, COMPARE already in place (turning it on while the count equals COMPARE
+     * raises nothing) */
+    q->CTRL = ENC_QEI__CTRL__CMP_EN_UPDATE(q->CTRL, 1u);
+}
+
 /* pending INDEX cleared, INDEX enabled onto irq (other enables kept) */
 static void enable_index_irq(volatile enc_qei_chan_t *q)
 {
@@ -86,16 +94,16 @@ void enc_qei_home_preset(volatile enc_qei_chan_t *q, uint64_t home_value, int ga
     uint32_t ic;
     q->PRESET_HI = (uint32_t)(home_value >> 32);
     q->PRESET_LO = (uint32_t)home_value;
-    ic = FIELD(ENC_QEI__INDEX_CTRL__ACTION, ENC_QEI__INDEX_CTRL__ACTION__PRESET) |
-         FIELD(ENC_QEI__INDEX_CTRL__ONESHOT, 1u) |
-         FIELD(ENC_QEI__INDEX_CTRL__EDGE, ENC_QEI__INDEX_CTRL__EDGE__RISING) |
-         FIELD(ENC_QEI__INDEX_CTRL__ARM, 1u);
+    ic = ENC_QEI__INDEX_CTRL__ACTION__PRESET_bm |
+         ENC_QEI__INDEX_CTRL__ONESHOT_bm |
+         ENC_QEI__INDEX_CTRL__EDGE__RISING_bm |
+         ENC_QEI__INDEX_CTRL__ARM_bm;
     if (gate_ab >= 0) {
         /* act only while (A, B) is this state inside the index pulse: the same shaft position
          * forward and backward */
-        ic |= FIELD(ENC_QEI__INDEX_CTRL__GATE_EN, 1u) |
-              FIELD(ENC_QEI__INDEX_CTRL__GATE_A, ((unsigned)gate_ab >> 1) & 1u) |
-              FIELD(ENC_QEI__INDEX_CTRL__GATE_B, (unsigned)gate_ab & 1u);
+        ic |= ENC_QEI__INDEX_CTRL__GATE_EN_bm |
+              ENC_QEI__INDEX_CTRL__GATE_A_SET(((unsigned)gate_ab >> 1) & 1u) |
+              ENC_QEI__INDEX_CTRL__GATE_B_SET((unsigned)gate_ab & 1u);
     }
     enable_index_irq(q);
     q->INDEX_CTRL = ic; /* armed from here on */
@@ -104,9 +112,9 @@ void enc_qei_home_preset(volatile enc_qei_chan_t *q, uint64_t home_value, int ga
 void enc_qei_home_latch(volatile enc_qei_chan_t *q)
 {
     enable_index_irq(q);
-    q->INDEX_CTRL = FIELD(ENC_QEI__INDEX_CTRL__ACTION, ENC_QEI__INDEX_CTRL__ACTION__LATCH) |
-                    FIELD(ENC_QEI__INDEX_CTRL__ONESHOT, 1u) |
-                    FIELD(ENC_QEI__INDEX_CTRL__ARM, 1u);
+    q->INDEX_CTRL = ENC_QEI__INDEX_CTRL__ACTION__LATCH_bm |
+                    ENC_QEI__INDEX_CTRL__ONESHOT_bm |
+                    ENC_QEI__INDEX_CTRL__ARM_bm;
 }
 
 int enc_qei_index_irq(volatile enc_qei_chan_t *q)
@@ -135,8 +143,8 @@ int64_t enc_qei_position_from_latch(volatile enc_qei_chan_t *q, unsigned count_w
 
 int enc_qei_read_errors(volatile enc_qei_chan_t *q, uint32_t *qerr, uint32_t *glitch, int clear)
 {
-    *qerr = (q->QERR_COUNT & ENC_QEI__QERR_COUNT__VALUE_bm) >> ENC_QEI__QERR_COUNT__VALUE_bp;
-    *glitch = (q->GLITCH_COUNT & ENC_QEI__GLITCH_COUNT__VALUE_bm) >> ENC_QEI__GLITCH_COUNT__VALUE_bp;
+    *qerr = ENC_QEI__QERR_COUNT__VALUE_GET(q->QERR_COUNT);
+    *glitch = ENC_QEI__GLITCH_COUNT__VALUE_GET(q->GLITCH_COUNT);
     if (clear) {
         /* an error between the read and this write is not counted (EVENTS.QERR / GLITCH still
          * show it) */

@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /*
  * enc_qei_example.h -- a firmware example for the enc_qei peripheral (C99), written against the
- * generated register header sw/enc_qei_regs.h only (enc_qei_t and enc_qei_chan_t,
- * ENC_QEI__<REG>__<FIELD>_bm / _bp masks and positions, ENC_QEI__<REG>__<FIELD>__<MEMBER> enum
- * values).
+ * generated register header sw/enc_qei_regs.h only (enc_qei_t and enc_qei_chan_t; per field
+ * ENC_QEI__<REG>__<FIELD>_bm, _SET(v) and _GET(w); per enum member ..._<MEMBER>_bm in place and
+ * ..._<MEMBER>_VAL as a field value).
  *
  * Every function takes a pointer to the registers, so the same code runs on the target
  *   volatile enc_qei_t *q = (volatile enc_qei_t *)ENC_QEI_BASE;   (your SoC's address)
@@ -22,8 +22,9 @@
 extern "C" {
 #endif
 
-/* CTRL word for a count function (ENC_QEI__CTRL__FUNC__*), a range (ENC_QEI__CTRL__RANGE__*) and
- * an input filter length 1 .. 16, with EN = 1, no swap, no inversion. Pure: touches no register. */
+/* CTRL word for a count function (a field value, ENC_QEI__CTRL__FUNC__*_VAL), a range
+ * (ENC_QEI__CTRL__RANGE__*_VAL) and an input filter length 1 .. 16, with EN = 1, no swap, no
+ * inversion. Pure: touches no register. */
 uint32_t enc_qei_ctrl_word(uint32_t func, uint32_t range, uint32_t filter_len);
 
 /* Set up counting: CTRL.FUNC = x4, the given FILTER_LEN and RANGE, CEILING (used by the modulo,
@@ -46,6 +47,12 @@ uint64_t enc_qei_read_count(volatile enc_qei_chan_t *q);
 
 /* Set the count: COUNT_HI first (staged), then COUNT_LO (loads both). */
 void enc_qei_write_count(volatile enc_qei_chan_t *q, uint64_t value);
+
+/* Compare: EVENTS.CMP (and a cmp_out pulse) each time the count changes to `value`: COMPARE
+ * written (HI first), the CMP interrupt enabled (a stale CMP cleared), then CTRL.CMP_EN set with
+ * CTRL's other fields kept. CTRL.CMP_EN is in register maps from 1.2 (ID.VERSION 0x0102) on, in
+ * builds with compare (not the lean profile). */
+void enc_qei_compare_at(volatile enc_qei_chan_t *q, uint64_t value);
 
 /* Homing, preset variant: load home_value into the count on the first index pulse, once
  * (INDEX_CTRL.ACTION = preset, ONESHOT, ARM), optionally gated by the (A, B) state gate_ab

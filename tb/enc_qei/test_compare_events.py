@@ -18,7 +18,7 @@ from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, play_clocks
-from enctools.regmap import event_bits, pack
+from enctools.regmap import event_bits, get_field, pack
 from enctools.tb import cocotb_test
 
 
@@ -106,7 +106,7 @@ async def events_and_irq(dut):
     for name in names:
         await bus.wr("IRQ_EN", 0)
         await bus.events()
-        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=3))
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=3, CMP_EN=1))
         await make(name)
         word = await bus.rd("EVENTS")
         assert word & event_bits(name), f"{name} not raised (EVENTS {word:#x})"
@@ -216,6 +216,56 @@ async def cmp_on_load(dut):
             assert len(high) == len(pulses), f"{what}: cmp_out high longer than one clock"
         await bus.wr("INDEX_CTRL", 0)
         model.idx_action = "none"
+    mon.cancel()
+
+
+@cocotb_test()
+async def compare_enable(dut):
+    """CTRL.CMP_EN: with 0 (the reset value) a walk through COMPARE and a COUNT write of it raise
+    no CMP and no cmp_out pulse; setting CMP_EN while the count equals COMPARE raises nothing; with
+    1 the next step onto COMPARE and a load of it do. Clearing CMP_EN stops it again."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    pulses = 0
+
+    async def count_pulses():
+        nonlocal pulses
+        while True:
+            await RisingEdge(dut.clk)
+            pulses += int(dut.cmp_out.value)
+
+    assert get_field("CTRL", "CMP_EN", await bus.rd("CTRL")) == 0, "CTRL.CMP_EN is not 0 after reset"
+    mon = cocotb.start_soon(count_pulses())
+    cmp = 0x10
+    await env.setup(model, count=cmp - 3, filter_len=1)  # compare=None: CMP_EN = 0
+    await bus.set64("COMPARE", cmp)
+    steps = [1] * 6 + [-1] * 6 + [1] * 3  # through COMPARE both ways, ending on it
+    await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+    await bus.set_count(cmp)
+    model.write_count(cmp)
+    await env.settle()
+    await env.check(model, "CMP_EN = 0: walk through COMPARE and a COUNT write of it")
+    assert pulses == 0, f"cmp_out pulsed {pulses} times with CMP_EN = 0"
+    ctrl = pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, CMP_EN=1)
+    await bus.wr("CTRL", ctrl)
+    await env.settle()
+    await env.check(model, "CMP_EN set while the count equals COMPARE")  # (model: compare None)
+    assert pulses == 0, "setting CMP_EN on COMPARE pulsed cmp_out"
+    model.compare, model.cmp_hits = cmp, 0
+    steps = [1, -1, -1, 1]  # off COMPARE and back onto it twice
+    await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+    await bus.set_count(cmp)
+    model.write_count(cmp)
+    await env.settle()
+    await env.check(model, "CMP_EN = 1: steps onto COMPARE and a load of it")
+    assert pulses == model.cmp_hits == 3, f"cmp_out pulsed {pulses} times, model {model.cmp_hits}"
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, CMP_EN=0))
+    model.compare = None
+    await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+    await env.settle()
+    await env.check(model, "CMP_EN cleared again")
+    assert pulses == 3, "cmp_out pulsed after CMP_EN was cleared"
     mon.cancel()
 
 

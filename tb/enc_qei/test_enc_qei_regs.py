@@ -6,6 +6,7 @@ register_walk in test_bus.py."""
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -31,14 +32,22 @@ def test_check_catches_a_stale_file(tmp_path):
     assert names == ["sw/enc_qei_regs.h"], names
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+@pytest.mark.skipif(shutil.which("gcc") is None or shutil.which("g++") is None,
+                    reason="gcc / g++ not installed")
 def test_c_header_compiles(tmp_path):
     header = TOP / "sw" / "enc_qei_regs.h"
-    for std in ([], ["-std=c11"], ["-std=gnu11"]):  # the header uses C11 static_assert
-        proc = subprocess.run(["gcc", "-Wall", "-Werror", "-fsyntax-only", *std, "-x", "c",
-                               str(header)], capture_output=True, text=True)
-        assert proc.returncode == 0, proc.stderr
-    # a user of the header: offsets, masks and enum values agree with the RDL
+    for cc, std in (("gcc", ["-std=c99", "-pedantic"]), ("gcc", ["-std=c11", "-pedantic"]),
+                    ("gcc", ["-std=gnu11"]), ("g++", ["-std=c++11", "-pedantic", "-x", "c++"])):
+        proc = subprocess.run([cc, "-Wall", "-Wextra", "-Werror", "-fsyntax-only", *std,
+                               *([] if cc == "g++" else ["-x", "c"]), str(header)],
+                              capture_output=True, text=True)
+        assert proc.returncode == 0, f"{cc} {std}: {proc.stderr}"
+
+
+def header_checks() -> list[str]:
+    """C11 static assertions of every name of the header against the compiled RDL: offsets,
+    struct layout, masks, positions, the field helpers, enum members (_VAL unshifted, _bm in
+    place, no bare member name) and whole-register reset values."""
     checks = []
     regs = nodes()
     assert len(regs) >= 30, "the register map reads as almost empty"
@@ -49,18 +58,69 @@ def test_c_header_compiles(tmp_path):
         if group == "chan":  # channel k's register at k * PAGE + offset
             checks.append(f"_Static_assert(offsetof(enc_qei_t, chan[3].{r.inst_name}) == "
                           f"{3 * PAGE + offset}u, \"p\");")
+        resets = [f.get_property("reset") for f in r.fields()]
+        if None not in resets:
+            value = sum(v << f.lsb for v, f in zip(resets, r.fields()))
+            checks.append(f"_Static_assert(ENC_QEI_{r.inst_name}_RESET == {value:#x}u, \"r\");")
+        else:
+            checks += [f"#ifdef ENC_QEI_{r.inst_name}_RESET", "#error a reset value of a live field",
+                       "#endif"]
         for f in r.fields():
+            p = f"ENC_QEI__{r.inst_name}__{f.inst_name}"
             m = ((1 << f.width) - 1) << f.lsb
-            checks.append(f"_Static_assert(ENC_QEI__{r.inst_name}__{f.inst_name}_bm == {m:#x}u, \"m\");")
-            enum = f.get_property("encode")
-            for e in enum or ():
-                checks.append(f"_Static_assert(ENC_QEI__{r.inst_name}__{f.inst_name}__{e.name.upper()}"
-                              f" == {e.value}u, \"e\");")
+            top = (1 << f.width) - 1
+            checks += [f"_Static_assert({p}_bm == {m:#x}u && {p}_bp == {f.lsb} && {p}_bw == {f.width}, \"m\");",
+                       # _SET places and masks, _GET extracts, _UPDATE replaces only the field
+                       f"_Static_assert({p}_SET({top}u) == {m:#x}u && {p}_SET({top + 1}u) == 0u, \"set\");",
+                       f"_Static_assert({p}_GET(0xFFFFFFFFu) == {top:#x}u && {p}_GET(~{m:#x}u) == 0u, \"get\");",
+                       f"_Static_assert({p}_UPDATE(0xFFFFFFFFu, 0u) == (~{m:#x}u & 0xFFFFFFFFu), \"u\");",
+                       f"_Static_assert({p}_UPDATE(0u, {top}u) == {m:#x}u, \"u\");"]
+            for e in f.get_property("encode") or ():
+                name = f"{p}__{e.name.upper()}"
+                checks += [f"_Static_assert({name}_VAL == {e.value}u, \"e\");",
+                           f"_Static_assert({name}_bm == {e.value << f.lsb:#x}u, \"e\");",
+                           f"_Static_assert({p}_GET({name}_bm) == {name}_VAL, \"e\");",
+                           f"#ifdef {name}", f"#error {name}: a bare member name (shifted or not?)",
+                           "#endif"]
+    return checks
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+def test_c_header_names_agree_with_the_rdl(tmp_path):
+    header = TOP / "sw" / "enc_qei_regs.h"
     src = tmp_path / "use.c"
-    src.write_text("#include <stddef.h>\n#include \"enc_qei_regs.h\"\n" + "\n".join(checks) + "\n")
+    src.write_text("#include <stddef.h>\n#include \"enc_qei_regs.h\"\n" + "\n".join(header_checks()) + "\n")
     proc = subprocess.run(["gcc", "-Wall", "-Werror", "-std=c11", "-fsyntax-only",
                            f"-I{header.parent}", str(src)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[:4000]
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not installed")
+def test_enum_member_written_into_its_register(tmp_path):
+    """The firmware engineer's first line: an enum member written into its register sets that
+    field, and nothing else (a value meant for SNAP_CTRL.EDGE must not take a snapshot)."""
+    header = TOP / "sw" / "enc_qei_regs.h"
+    edge = next(f for _, _, r in nodes() if r.inst_name == "SNAP_CTRL"
+                for f in r.fields() if f.inst_name == "EDGE")
+    a_rising = next(m.value for m in edge.get_property("encode") if m.name == "a_rising")
+    src = tmp_path / "edge.c"
+    src.write_text(
+        "#include <stdio.h>\n#include \"enc_qei_regs.h\"\n"
+        "int main(void) {\n    enc_qei_chan_t c = {0};\n"
+        "    c.SNAP_CTRL = ENC_QEI__SNAP_CTRL__EDGE__A_RISING_bm;\n"
+        "    printf(\"%lu %lu\\n\", (unsigned long)c.SNAP_CTRL,\n"
+        "           (unsigned long)(ENC_QEI__SNAP_CTRL__EDGE_SET(ENC_QEI__SNAP_CTRL__EDGE__A_RISING_VAL)"
+        " | ENC_QEI__SNAP_CTRL__IN_EN_bm));\n    return 0;\n}\n")
+    exe = tmp_path / "edge"
+    proc = subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", f"-I{header.parent}",
+                           str(src), "-o", str(exe)], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
+    word, word2 = (int(x) for x in subprocess.run([str(exe)], capture_output=True, text=True,
+                                                  check=True).stdout.split())
+    fields = {f.inst_name: f for _, _, r in nodes() if r.inst_name == "SNAP_CTRL" for f in r.fields()}
+    assert word == a_rising << fields["EDGE"].lsb, f"SNAP_CTRL = {word:#x}"
+    assert not word & (1 << fields["CMD"].lsb), "the EDGE value took a snapshot (CMD set)"
+    assert word2 == word | (1 << fields["IN_EN"].lsb)
 
 
 def test_rdl_has_the_contract_names():
@@ -111,3 +171,48 @@ def test_rdl_has_the_multi_axis_names():
 def _reg(name):
     return next(r for _, _, r in nodes() if r.inst_name == name)
 
+
+
+def offset_mentions(text: str, names: list[str]):
+    """(register, offset) for every place a text gives a register next to an offset: `REG` then
+    0xNN within a few characters of the same table cell or sentence, `0xNN | REG` in a table row,
+    `uint32_t REG;  /* 0xNN */` in a struct, `// reg - REG (0xNN` and ENC_QEI_REG_OFFSET 0xNN."""
+    alt = "|".join(sorted(names, key=len, reverse=True))
+    pats = [rf"\b({alt})\b(?!_)[^|\n0-9]{{0,14}}?\b0x([0-9A-Fa-f]{{1,2}})\b(?![0-9A-Fa-f])",
+            rf"\b0x([0-9A-Fa-f]{{1,2}})\s*\|\s*\[?`?({alt})\b(?!_)",
+            rf"\bENC_QEI_({alt})_OFFSET\s+0x([0-9A-Fa-f]+)u"]
+    for k, pat in enumerate(pats):
+        for m in re.finditer(pat, text):
+            reg, off = (m.group(2), m.group(1)) if k == 1 else (m.group(1), m.group(2))
+            yield reg, int(off, 16)
+
+
+def test_one_offset_per_register():
+    """Every register is given at the offset the bus sees (its offset in page 0) in the register
+    reference, the C header and the docs: never at the RDL regfile's relative offset."""
+    regs = {r.inst_name: off for _, off, r in nodes()}
+    files = [TOP / "doc" / "enc_qei_regs.md", TOP / "sw" / "enc_qei_regs.h", TOP / "README.md",
+             *sorted((TOP / "doc").glob("*.md"))]
+    seen, wrong = {}, []
+    for path in dict.fromkeys(files):
+        for reg, off in offset_mentions(path.read_text(), list(regs)):
+            seen.setdefault(path.name, set()).add(reg)
+            if off != regs[reg]:
+                wrong.append(f"{path.relative_to(TOP)}: {reg} at 0x{off:02X}, the bus offset is "
+                             f"0x{regs[reg]:02X}")
+    assert not wrong, "\n".join(wrong)
+    # the reference and the header give every register's offset
+    for name in ("enc_qei_regs.md", "enc_qei_regs.h"):
+        assert seen.get(name, set()) == set(regs), f"{name}: no offset for {set(regs) - seen.get(name, set())}"
+    text = (TOP / "doc" / "enc_qei_regs.md").read_text()
+    assert "Base Offset" not in text, "the reference gives a second, relative offset"
+
+
+def test_offset_mentions_finds_a_relative_offset():
+    regs = ["CTRL", "COUNT_LO", "COUNT_HI"]
+    assert list(offset_mentions("| 0x00 |      CTRL     |", regs)) == [("CTRL", 0)]
+    assert list(offset_mentions("| 0x10 | [COUNT_LO](#count_lo) |", regs)) == [("COUNT_LO", 0x10)]
+    assert list(offset_mentions("`COUNT_HI` (0x0C)", regs)) == [("COUNT_HI", 0x0C)]
+    assert list(offset_mentions("    uint32_t COUNT_LO;  /* 0x10 */", regs)) == [("COUNT_LO", 0x10)]
+    assert list(offset_mentions("#define ENC_QEI_CTRL_OFFSET 0x08u", regs)) == [("CTRL", 8)]
+    assert list(offset_mentions("CTRL_HI 0x10, COUNT_W 8", regs)) == []

@@ -90,8 +90,9 @@ async def snapshot_coherence(dut):
 
 @cocotb_test()
 async def snapshot_deltas_across_wraps(dut):
-    """SNAP_DELTA counts applied steps across modulo wraps and limits; SNAP_EDGE_DELTA is the
-    count change between the last selected edges (any edge, and A rising with x4 counting)."""
+    """SNAP_DELTA counts the motion (every step of the function) across modulo wraps and limit
+    stops; SNAP_EDGE_DELTA is the position change between the last selected edges (any edge, and
+    A rising with x4 counting), whatever the range did to the count."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -112,10 +113,10 @@ async def snapshot_deltas_across_wraps(dut):
             await env.settle(4)
             snap = await read_snapshot(bus)
             assert signed(snap["delta"]) == model.delta, \
-                f"{mode}: SNAP_DELTA {signed(snap['delta'])}, model {model.delta} applied steps"
-            # edge delta: position change between the last selected edges, in free/modulo
-            # every step is applied, so counts = positions
-            if mode != "limit":
+                f"{mode}: SNAP_DELTA {signed(snap['delta'])}, model {model.delta} steps of motion"
+            # edge delta: position change between the last selected edges (the motion, in every
+            # range: a step a limit blocks counts too)
+            if True:
                 if edge == "any":
                     last = len(pos_hist) - 1
                 else:
@@ -227,6 +228,50 @@ async def unit_timer_prescaled(dut):
     await bus.wr("TB_PRESCALE", 0)
     await bus.wr("IRQ_EN", 0)
     await bus.events()
+
+
+@cocotb_test()
+async def snapshot_delta_across_presets(dut):
+    """A preset on every index (a rotary axis referenced every turn) at the count-rate bound:
+    SNAP_DELTA and SNAP_EDGE_DELTA count the motion, the steps the shaft moved, including the
+    step of the transition an index preset overrides; SNAP_COUNT is the model's count. Forward,
+    backward and turning walks over many index pulses, snapshots by bus command between them."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    rev = 40  # 4X counts per revolution: an index pulse at positions 0 .. 2 of each
+    zf = lambda p: int(p % rev < 3)  # noqa: E731  (Z rises with the transition onto p % rev == 0)
+    for func in ("x4", "x2a"):
+        await env.setup(model, func=func, count=0, filter_len=1)
+        preset = rng.randint(1000, 5000)
+        await bus.set64("PRESET", preset)
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+        model.idx_gate, model.idx_oneshot = None, False
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        model.delta = 0
+        model.idx_hits = 0
+        for steps in ([1] * 170, [-1] * 130, [1, 1, 1, -1] * 30, [-1] * 90):
+            wf = walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos)
+            await env.play(wf, model, zfun=zf)
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+            await env.settle(4)
+            snap = await read_snapshot(bus)
+            assert signed(snap["delta"]) == model.delta, \
+                f"{func}: SNAP_DELTA {signed(snap['delta'])} after {model.idx_hits} presets, " \
+                f"model {model.delta} steps of motion"
+            # (EDGE any: every step is at an edge, so the steps between the two last edges are all
+            # the steps between the snapshots)
+            assert signed(snap["edge_delta"]) == model.delta, \
+                f"{func}: SNAP_EDGE_DELTA {signed(snap['edge_delta'])}, model {model.delta}"
+            count = snap["count"] | snap["count_hi"] << 32
+            assert count == model.count, f"{func}: SNAP_COUNT {count:#x}, model {model.count:#x}"
+            model.delta = 0
+        assert model.idx_hits >= 10, f"{func}: only {model.idx_hits} index pulses"
+        dut._log.info("%s: %d index presets, SNAP_DELTA = the motion", func, model.idx_hits)
+    await bus.wr("INDEX_CTRL", 0)
+    await bus.wr("SNAP_CTRL", 0)
 
 
 @cocotb_test()

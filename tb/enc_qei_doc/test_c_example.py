@@ -80,11 +80,11 @@ int main(void)
     uint32_t qerr = 0, glitch = 0;
     int r;
 
-    P("ctrl_word", enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X2B, ENC_QEI__CTRL__RANGE__LIMIT, 7u));
+    P("ctrl_word", enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X2B_VAL, ENC_QEI__CTRL__RANGE__LIMIT_VAL, 7u));
 
     /* setup: garbage before, the example's writes after */
     memset(&regs, 0xA5, sizeof regs);
-    enc_qei_setup_x4(Q, 5u, ENC_QEI__CTRL__RANGE__MODULO, 0x00000001000007CFull);
+    enc_qei_setup_x4(Q, 5u, ENC_QEI__CTRL__RANGE__MODULO_VAL, 0x00000001000007CFull);
     P("setup.CTRL", regs.CTRL);
     P("setup.CEILING_LO", regs.CEILING_LO);
     P("setup.CEILING_HI", regs.CEILING_HI);
@@ -115,6 +115,17 @@ int main(void)
     PS("signed.neg1_64", enc_qei_to_signed(0xFFFFFFFFFFFFFFFFull, 64u));
     PS("signed.min_64", enc_qei_to_signed(0x8000000000000000ull, 64u));
     PS("signed.min_64_plus1", enc_qei_to_signed(0x8000000000000001ull, 64u) + 1);
+
+    /* compare: CTRL's other fields kept, CMP_EN set */
+    memset(&regs, 0, sizeof regs);
+    regs.CTRL = enc_qei_ctrl_word(ENC_QEI__CTRL__FUNC__X1A_VAL, ENC_QEI__CTRL__RANGE__MODULO_VAL, 9u);
+    regs.IRQ_EN = ENC_QEI__EVENTS__INDEX_bm;
+    enc_qei_compare_at(Q, 0x0000000300000010ull);
+    P("cmp.COMPARE_LO", regs.COMPARE_LO);
+    P("cmp.COMPARE_HI", regs.COMPARE_HI);
+    P("cmp.CTRL", regs.CTRL);
+    P("cmp.IRQ_EN", regs.IRQ_EN);
+    P("cmp.EVENTS", regs.EVENTS);
 
     /* homing by preset, gated at (A, B) = (1, 0) */
     memset(&regs, 0, sizeof regs);
@@ -223,6 +234,16 @@ def test_count_arithmetic(harness_out):
     assert o["signed.min_64_plus1"] == -(1 << 63) + 2
 
 
+def test_compare_on(harness_out):
+    o = harness_out
+    ctrl = (bit("CTRL", "EN") | fv("CTRL", "FUNC", "x1a") | fv("CTRL", "RANGE", "modulo")
+            | fv("CTRL", "FILTER_LEN", 9))
+    assert (o["cmp.COMPARE_HI"], o["cmp.COMPARE_LO"]) == (3, 0x10)
+    assert o["cmp.CTRL"] == ctrl | bit("CTRL", "CMP_EN"), "CMP_EN not set, or CTRL's fields lost"
+    assert o["cmp.IRQ_EN"] == bit("EVENTS", "INDEX") | bit("EVENTS", "CMP")
+    assert o["cmp.EVENTS"] == bit("EVENTS", "CMP")
+
+
 def test_homing_and_index_interrupt(harness_out):
     o = harness_out
     index, cmp_, qerr = bit("EVENTS", "INDEX"), bit("EVENTS", "CMP"), bit("EVENTS", "QERR")
@@ -303,18 +324,24 @@ def doc_refs(text: str):
 
 
 def c_refs(text: str, where: str):
-    """Register/field/enum names a C text uses: ENC_QEI__REG__FIELD[_bm|_bp|_bw|_reset],
-    ENC_QEI__REG__FIELD__MEMBER, ENC_QEI_REG_OFFSET and ->REG / .REG struct members."""
+    """Register/field/enum names a C text uses: ENC_QEI__REG__FIELD[_bm|_bp|_bw|_reset|_SET|_GET|
+    _UPDATE], ENC_QEI__REG__FIELD__MEMBER_VAL / _bm, ENC_QEI_REG_OFFSET / _RESET and ->REG / .REG
+    struct members."""
     regs = rdl()
     for m in re.finditer(r"\bENC_QEI__([A-Za-z0-9_]+)", text):
         parts = m.group(1).split("__")
         if len(parts) < 2 or parts[0] == "":
             yield None, None, None, f"{where}: malformed {m.group(0)}"
             continue
-        reg, field = parts[0], re.sub(r"_(bm|bp|bw|reset)$", "", parts[1])
-        member = parts[2].lower() if len(parts) > 2 and parts[2] else None  # `__*`: any member
+        reg, field = parts[0], re.sub(r"_(bm|bp|bw|reset|SET|GET|UPDATE)$", "", parts[1])
+        member = None
+        if len(parts) > 2 and parts[2] not in ("", "*_VAL", "*_bm", "*"):  # `__*`: any member
+            if not re.search(r"_(VAL|bm)$", parts[2]):
+                yield None, None, None, f"{where}: {m.group(0)}: an enum member is _VAL or _bm"
+                continue
+            member = re.sub(r"_(VAL|bm)$", "", parts[2]).lower()
         yield reg, field, member, where
-    for m in re.finditer(r"\bENC_QEI_([A-Z][A-Z0-9_]*)_OFFSET\b", text):
+    for m in re.finditer(r"\bENC_QEI_([A-Z][A-Z0-9_]*)_(?:OFFSET|RESET)\b", text):
         yield m.group(1), None, None, where
     for m in re.finditer(r"(?:->|\bregs\.)([A-Z][A-Z0-9_]*)\b", text):
         if m.group(1) not in regs:

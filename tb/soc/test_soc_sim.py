@@ -5,7 +5,11 @@ The SoC (VexRiscv, ROM, SRAM, UART, 4 full channels driven by tools/enctools/lit
 runs sw/soc/main.c: discovery from ID and CAPS, the 1 kHz global snapshot, the interrupt
 handler's positions and velocities. enctools.litex.check compares what it printed with the model
 (its docstring states the velocity bound). The firmware built with FW_FAULT=page reads one
-register from the wrong channel page, and the same check must fail on it.
+register from the wrong channel page, and the same check must fail on it. The edge-FIFO build
+(simsoc.EFIFO: 3 channels, 256 entries each) runs the same firmware, which drains the FIFOs;
+check.check_efifo compares the entries with the model's steps, and must fail on the firmware
+built with FW_FAULT=efifo (an entry's direction from the wrong bit). Both builds read one
+unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and reads all ones.
 
 Run by `make soc-sim` (ENC_SOC_SIM=1), after scripts/soc_sim.py has built the simulator; the
 builds and runs are cached, so this reuses them. Skipped by `make test`.
@@ -22,20 +26,22 @@ if os.environ.get("ENC_SOC_SIM") != "1":
 
 from enctools.litex import check, simsoc  # noqa: E402
 
-CFG = simsoc.SocConfig()
+CFG = simsoc.MAIN
+ECFG = simsoc.EFIFO
+BUS_TIMEOUT = 10**6   # LiteX's Wishbone timeout (SoCCore bus_timeout), in clocks
 
 
-def _run(fault=None):
-    simsoc.build_gateware(CFG)
-    fw = simsoc.build_firmware(CFG, fault)
-    out, _ = simsoc.run(CFG, fw)
+def _run(fault=None, cfg=CFG):
+    simsoc.build_gateware(cfg)
+    fw = simsoc.build_firmware(cfg, fault)
+    out, _ = simsoc.run(cfg, fw)
     run = check.parse(out)
-    return run, check.check(CFG.motions(), run)
+    return (run, *check.check_run(cfg.motions(), run))
 
 
 @pytest.fixture(scope="module")
 def good():
-    return _run()
+    return _run()[:2]
 
 
 def _fails(res, what):
@@ -46,7 +52,7 @@ def test_firmware_finds_the_build(good):
     run, res = good
     assert run.done, "the firmware did not print DONE"
     assert run.build == {"channels": CFG.channels, "profile": 2, "count_w": 32, "ts_w": 32,
-                         "clk_hz": CFG.clk_hz, "period": CFG.clk_hz // 1000}
+                         "clk_hz": CFG.clk_hz, "period": CFG.clk_hz // 1000, "efifo_log2": 0}
     assert len(run.rows) == CFG.snapshots
 
 
@@ -82,7 +88,45 @@ def test_handler_cycles_reported(good):
 
 
 def test_wrong_page_fails_the_check():
-    run, res = _run("page")
+    run, res, _ = _run("page")
     assert run.done
     assert not res.ok
     assert _fails(res, "positions"), res.failures
+
+
+@pytest.fixture(scope="module")
+def efifo_run():
+    return _run(cfg=ECFG)
+
+
+def test_efifo_build_positions_and_velocity(efifo_run):
+    run, res, _ = efifo_run
+    assert run.done and run.build["efifo_log2"] == ECFG.efifo_log2
+    assert run.build["channels"] == ECFG.channels
+    assert res.ok, res.failures
+
+
+def test_efifo_entries_are_the_model_steps(efifo_run):
+    run, res, fifo = efifo_run
+    assert fifo.ok, fifo.failures
+    assert fifo.offset == res.delay          # one time axis with the snapshots
+    assert all(run.efifo[k]["entries"] > 100 for k in range(ECFG.channels)), run.efifo
+    assert sum(run.efifo[k]["dir_changes"] for k in range(ECFG.channels)) >= 2
+    assert sum(run.efifo[k]["idx"] for k in range(ECFG.channels)) >= 1
+
+
+def test_wrong_efifo_field_fails_the_check():
+    run, res, fifo = _run("efifo", ECFG)
+    assert run.done
+    assert not fifo.ok and [m for w, m in fifo.failures if w == "efifo"], fifo.failures
+
+
+@pytest.mark.parametrize("which", ["main", "efifo"])
+def test_unmapped_offset_on_vexriscv(which, good, efifo_run):
+    """The peripheral answers wb_err_o; VexRiscv does not take it as an answer, so the access
+    waits for LiteX's bus timeout, which answers all ones (and counts a bus error)."""
+    run = (good if which == "main" else efifo_run)[0]
+    u = run.unmapped
+    assert u["value"] == 0xFFFFFFFF, u
+    assert BUS_TIMEOUT <= u["cycles"] < BUS_TIMEOUT + 1000, u
+    assert u["bus_errors"] == 1, u

@@ -26,6 +26,15 @@ compares them with ``motion``'s exact model:
   counted no miss, no torn read and no skewed SNAP_TIME.
 - **Index and errors**: each INDEX_LATCH (read at the end, while the motion goes on) is a count
   at an index position of the model, and the QERR and GLITCH counters are 0.
+
+``check_efifo(motions, run)`` compares a build's edge-FIFO statistics (the E lines: every entry
+the firmware drained, from the FIFO's start to its last entry) with the model's steps: the entries
+are exactly the model's steps up to the last entry's time (their number, the sum of their
+directions, the direction changes, the steps onto an index position marked IDX, the sum of their
+times), each timestamped at the step's clock + one offset for every channel; times increase,
+every (A, B) follows the previous one, nothing LOST. ``check_run(motions, run)`` runs both: the
+FIFO's offset must be a D that fits every position (one time axis with the snapshots), and it is
+the D of the velocity check.
 """
 
 from __future__ import annotations
@@ -37,6 +46,10 @@ import numpy as np
 from . import motion
 
 
+EFIFO_FIELDS = ("k", "entries", "net", "dir_changes", "idx", "lost", "nonmono", "ab_bad",
+                "t_first", "t_last", "sum_t", "efifo_lost", "cycles")
+
+
 @dataclass
 class Run:
     build: dict = field(default_factory=dict)
@@ -44,6 +57,8 @@ class Run:
     cycles: dict = field(default_factory=dict)    # k -> (min, mean, max)
     ends: dict = field(default_factory=dict)      # k -> (count, index_latch, qerr, glitch)
     misses: tuple = (None, None, None)
+    efifo: dict = field(default_factory=dict)     # k -> {name: value} of its E line
+    unmapped: dict = field(default_factory=dict)  # the U line: offset, value, cycles, bus_errors
     done: bool = False
     table: list = field(default_factory=list)     # the console's table lines, as printed
 
@@ -54,9 +69,9 @@ def parse(console: str) -> Run:
         f = line.split()
         if not f:
             continue
-        if f[0] == "BUILD" and len(f) == 7:
-            r.build = dict(zip(("channels", "profile", "count_w", "ts_w", "clk_hz", "period"),
-                               map(int, f[1:])))
+        if f[0] == "BUILD" and len(f) == 8:
+            r.build = dict(zip(("channels", "profile", "count_w", "ts_w", "clk_hz", "period",
+                                "efifo_log2"), map(int, f[1:])))
         elif f[0] == "S":
             v = [x for x in f[1:] if x != "|"]
             n, t, lat, cyc = (int(x) for x in v[:4])
@@ -70,6 +85,11 @@ def parse(console: str) -> Run:
             r.ends[int(f[1])] = tuple(int(x) for x in f[2:])
         elif f[0] == "M" and len(f) == 4:
             r.misses = tuple(int(x) for x in f[1:])
+        elif f[0] == "E" and len(f) == 1 + len(EFIFO_FIELDS):
+            r.efifo[int(f[1])] = dict(zip(EFIFO_FIELDS[1:], map(int, f[2:])))
+        elif f[0] == "U" and len(f) == 5:
+            r.unmapped = dict(zip(("offset", "value", "cycles", "bus_errors"),
+                                  (int(x, 0) for x in f[1:])))
         elif f[0] == "DONE":
             r.done = True
         elif line.lstrip().startswith("snap "):
@@ -140,7 +160,11 @@ def _ref_readings(ch: Channel, times: np.ndarray, d: int, clk_hz: float, edge_of
     return np.array([r.mt for r in VelocityEstimator(cfg).run(snaps)]), pairs
 
 
-def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0) -> Result:
+def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
+          delay: int | None = None) -> Result:
+    """The checks of the module docstring. ``delay``: the D to use when several fit every
+    position (the edge FIFO's, which its entries' times pin to the clock); without it, or when
+    it does not fit, the middle one of those that fit."""
     fails: list[tuple[str, str]] = []   # (what, message); what: finish, snapshots, positions,
                                         # velocity or index
 
@@ -179,7 +203,7 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0) -> Res
                          f"{len(times)} snapshots for every delay (best D = {best}; first at "
                          f"snapshot {bad[0]}: read {pos[bad[0], k]}, model "
                          f"{chans[k].count(times[bad[0]] - best)})")
-    d = delays[len(delays) // 2] if delays else None
+    d = delay if delay in delays else delays[len(delays) // 2] if delays else None
 
     nvel = nbound = nzero = 0
     offsets: set[int] = set()
@@ -252,3 +276,84 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0) -> Res
     ]
     return Result(not fails, fails, delays, d, len(times) * nch, nvel, nbound, nzero, worst,
                   worst_const, summary)
+
+
+@dataclass
+class EfifoResult:
+    ok: bool
+    failures: list         # (what, message): what is "efifo"
+    entries: int           # entries drained, all channels
+    offset: int | None     # entry time - model step clock (None: not one for every channel)
+    cycles_per_entry: float
+    summary: list
+
+
+def check_efifo(motions: list[motion.Motion], run: Run) -> EfifoResult:
+    """The E lines against the model's steps (the module docstring)."""
+    fails = []
+    nch = run.build.get("channels", 0)
+    if not run.build.get("efifo_log2"):
+        return EfifoResult(False, [("efifo", "the build has no edge FIFO (BUILD efifo_log2 0)")],
+                           0, None, 0.0, [])
+    total = cycles = 0
+    offsets = set()
+    for k in range(nch):
+        e = run.efifo.get(k)
+        if e is None:
+            fails.append(("efifo", f"channel {k}: no E line"))
+            continue
+        total += e["entries"]
+        cycles += e["cycles"]
+        x = Channel(motions[k], e["t_last"] + 10).x
+        steps = np.flatnonzero(x[1:] != x[:-1]) + 1         # clocks at which x changed
+        if np.any(np.abs(np.diff(x)) > 1):
+            fails.append(("efifo", f"channel {k}: the model moves more than one step per clock"))
+            continue
+        if steps.size == 0 or e["entries"] == 0:
+            if steps.size or e["entries"]:
+                fails.append(("efifo", f"channel {k}: {e['entries']} entries, model steps {steps.size}"))
+            continue
+        off = e["t_first"] - int(steps[0])
+        offsets.add(off)
+        steps = steps[steps + off <= e["t_last"]]
+        up = x[steps] > x[steps - 1]
+        expect = {
+            "entries": int(steps.size),
+            "net": int(x[steps[-1]] - x[0]),
+            "dir_changes": int(np.sum(up[1:] != up[:-1])),
+            "idx": int(np.sum((x[steps] & ((1 << motion.CPR_LOG2) - 1)) == 0)),
+            "lost": 0, "nonmono": 0, "ab_bad": 0, "efifo_lost": 0,
+            "t_last": int(steps[-1]) + off,
+            "sum_t": int(np.sum(steps + off)) & 0xFFFFFFFF,
+        }
+        for name, want in expect.items():
+            if e[name] != want:
+                fails.append(("efifo", f"channel {k}: {name} {e[name]}, the model's steps give {want}"))
+    if len(offsets) > 1:
+        fails.append(("efifo", f"entry times are the step's clock + {sorted(offsets)}: not one "
+                               "offset for every channel"))
+    per = cycles / total if total else 0.0
+    summary = [
+        f"edge FIFO: {total} entries drained from {nch} channels "
+        f"{'equal' if not fails else 'compared with'} the model's steps (number, directions, "
+        f"direction changes, IDX marks, times = the step's clock + "
+        f"{','.join(map(str, sorted(offsets))) or '-'}), times increasing, every (A, B) the "
+        f"successor of the previous, no LOST{'' if not fails else ': ' + str(len(fails)) + ' differ'}"
+        f"; {per:.0f} CPU cycles per entry (two reads and the firmware's bookkeeping)",
+    ]
+    return EfifoResult(not fails, fails, total, offsets.pop() if len(offsets) == 1 else None, per,
+                       summary)
+
+
+def check_run(motions: list[motion.Motion], run: Run) -> tuple[Result, EfifoResult | None]:
+    """check(), and with an edge FIFO check_efifo() first: its offset is the D of check(), and
+    must fit every position."""
+    if not run.build.get("efifo_log2"):
+        return check(motions, run), None
+    fifo = check_efifo(motions, run)
+    res = check(motions, run, delay=fifo.offset)
+    if fifo.offset is not None and fifo.offset not in res.delays:
+        fifo.failures.append(("efifo", f"entry times are the step's clock + {fifo.offset}, which "
+                                       f"fits no position (D fitting them: {res.delays})"))
+        fifo.ok = False
+    return res, fifo

@@ -49,10 +49,12 @@ class SocConfig:
     clk_hz: int = 50_000_000     # the declared sys clock: 1 timebase tick = 20 ns
     snapshots: int = 100         # global snapshots the firmware records (one per ms)
     opt_level: str = "O3"        # C++ optimisation of the Verilated model
+    efifo_log2: int = 0          # the edge FIFO of every channel: 2^efifo_log2 entries, 0 none
+    motion_names: tuple = ()     # the channels' motions by name (motion.profiles); () all four
 
     @property
     def tag(self) -> str:
-        return f"ch{self.channels}_{self.profile}"
+        return f"ch{self.channels}_{self.profile}" + (f"_efifo{self.efifo_log2}" if self.efifo_log2 else "")
 
     @property
     def out(self) -> Path:
@@ -60,7 +62,17 @@ class SocConfig:
 
     def motions(self) -> list[motion.Motion]:
         base = motion.profiles(self.clk_hz)
+        if self.motion_names:
+            by_name = {m.name: m for m in base}
+            base = [by_name[n] for n in self.motion_names]
         return [base[k % len(base)] for k in range(self.channels)]
+
+
+# the builds `make soc-sim` runs: the 4 motions without an edge FIFO, and an edge-FIFO build whose
+# firmware drains every channel's FIFO (without the steady channel's 3.1 million steps per
+# second, which no firmware on this CPU could drain: doc/litex.md)
+MAIN = SocConfig()
+EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
 
 
 def _log(msg: str) -> None:
@@ -100,7 +112,7 @@ def make_soc(cfg: SocConfig):
                 integrated_sram_size=SRAM_SIZE, uart_name="sim")
             self.motion = motion.MotionGen(cfg.motions()).module()
             add_enc_qei(self, name="enc_qei", pads=self.motion, channels=cfg.channels,
-                        profile=cfg.profile)
+                        profile=cfg.profile, efifo_log2=cfg.efifo_log2)
             self.sim_finish = SimFinish()
 
     return EncSimSoC()

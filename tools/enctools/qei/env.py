@@ -68,13 +68,15 @@ class Env:
         bus = self.bus
         model.range = rng_mode
         model.ceiling = model.max if ceiling is None else ceiling
-        model.compare = 0 if compare is None else compare
-        if self.lean:  # (CEILING and COMPARE are still written: they must have no effect)
+        # compare=None: CTRL.CMP_EN = 0 (compare off); a value: CMP_EN = 1
+        model.compare = compare
+        if self.lean:  # (CEILING, COMPARE and CMP_EN are still written: they must have no effect)
             model.compare = None
         model.en = bool(en)
         await bus.set64("CEILING", model.ceiling)
-        await bus.set64("COMPARE", model.compare or 0)
-        ctrl = pack("CTRL", EN=en, FUNC=func, RANGE=rng_mode, FILTER_LEN=filter_len)
+        await bus.set64("COMPARE", compare or 0)
+        ctrl = pack("CTRL", EN=en, FUNC=func, RANGE=rng_mode, FILTER_LEN=filter_len,
+                    CMP_EN=int(compare is not None))
         await bus.wr("CTRL", ctrl)
         model.set_func(func, QUAD[self.pos % 4])
         await bus.set_count(count)

@@ -37,13 +37,13 @@ class QeiModel:
         self.range = "free"
         self.en = True
         self.ceiling = self.max
-        self.compare = 0  # None: a build without the compare unit (PROFILE lean)
+        self.compare = None  # None: compare off (CTRL.CMP_EN = 0, the reset) or no compare unit
         self.count = 0
         self.stopped = False
         self.dir = 1
         self.events: set[str] = set()
         self.qerrs = 0
-        self.delta = 0  # applied steps (for SNAP_DELTA)
+        self.delta = 0  # the function's steps while EN, the motion (for SNAP_DELTA)
         self.prev = None
         self.hyst_d = 0  # x1_hyst: d = p - 4n, in -1 .. 3
         self.cmp_hits = 0
@@ -147,6 +147,7 @@ class QeiModel:
         if prev is not None and prev != cur:
             step = self.func_step(prev, cur)
             if step and self.en:
+                self.delta += step  # the motion: every step of the function while EN
                 self.apply(step, no_load=not preset)
         if armed and self.idx_action == "latch":
             self.idx_latch = self.count
@@ -198,7 +199,6 @@ class QeiModel:
         if took:
             self.count = c
             if no_load:  # a step overridden by a load in the same clock is not a count change
-                self.delta += step
                 self._changed()
 
     def _changed(self) -> None:

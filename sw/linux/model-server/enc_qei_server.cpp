@@ -1,0 +1,224 @@
+// SPDX-License-Identifier: Apache-2.0
+// enc_qei_server -- a Verilator model of enc_qei_wb serving register accesses over a Unix socket,
+// for the UML bridge of `make linux-test` (sw/linux/uml-bridge/enc_qei_bridge.c).
+//
+// Usage: enc_qei_server --socket PATH [--id WORD]
+//
+// The server listens on PATH and accepts two connections: the first carries requests, the second
+// the interrupt. A request is four 32-bit words {op, addr, data, sel}; the answer two {data,
+// status}. op 1 reads the register at byte address addr (one Wishbone access), op 2 writes data
+// with byte enables sel, op 3 advances the encoders by data motion steps (sw/linux/stimulus.h:
+// each step's inputs held for ENC_STIM_STEP_CLOCKS clocks). status is 1 when the peripheral
+// answered with wb_err_o (or the address is outside its ADDR_W bits), else 0. After every request
+// and before its answer, the server sends one byte on the interrupt connection if the irq output
+// rose since the last one it reported. --id makes reads of ID answer WORD instead of the RTL's ID
+// (the driver's refusal of a wrong ID or version is tested with it). The parameters of the build
+// (CHANNELS, PROFILE, COUNT_W, TS_W, FUNC_MASK, ADDR_W) are Verilator -G options of the model;
+// ENC_QEI_ADDR_W (a -D option) is the same ADDR_W.
+// The server exits when the request connection closes.
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include "Venc_qei_wb.h"
+#include "verilated.h"
+
+extern "C" {
+#include "stimulus.h"
+}
+
+namespace {
+
+constexpr uint32_t kOpRead = 1, kOpWrite = 2, kOpAdvance = 3;
+constexpr int kMaxChannels = 16;
+
+Venc_qei_wb *top;
+struct enc_stim stim[kMaxChannels];
+int channels;
+uint64_t clocks;
+
+void tick() {
+    top->clk = 0;
+    top->eval();
+    top->clk = 1;
+    top->eval();
+    clocks++;
+}
+
+void drive_inputs() {
+    uint32_t a = 0, b = 0, z = 0;
+    for (int k = 0; k < channels; k++) {
+        a |= enc_stim_a(stim[k].pos) << k;
+        b |= enc_stim_b(stim[k].pos) << k;
+        z |= enc_stim_z(stim[k].pos) << k;
+    }
+    top->a_in = a;
+    top->b_in = b;
+    top->z_in = z;
+}
+
+// One Wishbone access; returns the status (0 ack, 1 err) and the read data in *data.
+uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
+    top->wb_adr_i = addr;
+    top->wb_dat_i = *data;
+    top->wb_sel_i = sel;
+    top->wb_we_i = we;
+    top->wb_cyc_i = 1;
+    top->wb_stb_i = 1;
+    top->eval();
+    uint32_t status = 1;
+    *data = 0;
+    for (int i = 0; i < 16; i++) {
+        tick();
+        if (top->wb_ack_o || top->wb_err_o) {
+            status = top->wb_err_o ? 1 : 0;
+            *data = top->wb_dat_o;
+            break;
+        }
+    }
+    top->wb_cyc_i = 0;
+    top->wb_stb_i = 0;
+    tick();
+    return status;
+}
+
+bool full_io(int fd, void *buf, size_t len, bool rd) {
+    char *p = static_cast<char *>(buf);
+    while (len) {
+        ssize_t n = rd ? read(fd, p, len) : write(fd, p, len);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return false;
+        p += n;
+        len -= static_cast<size_t>(n);
+    }
+    return true;
+}
+
+int usage(const char *msg) {
+    fprintf(stderr, "enc_qei_server: %s\nusage: enc_qei_server --socket PATH [--id WORD]\n", msg);
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+    const char *path = nullptr;
+    bool id_override = false;
+    uint32_t id_word = 0;
+    for (int i = 1; i < argc; i++) {
+        std::string arg = argv[i];
+        if (arg == "--socket" && i + 1 < argc) {
+            path = argv[++i];
+        } else if (arg == "--id" && i + 1 < argc) {
+            char *end;
+            id_word = static_cast<uint32_t>(strtoul(argv[++i], &end, 0));
+            if (*end)
+                return usage("--id takes a number");
+            id_override = true;
+        } else {
+            return usage(("unknown argument " + arg).c_str());
+        }
+    }
+    if (!path)
+        return usage("--socket is required");
+
+    int lfd = socket(AF_UNIX, SOCK_STREAM, 0);
+    sockaddr_un sa{};
+    sa.sun_family = AF_UNIX;
+    if (strlen(path) >= sizeof(sa.sun_path))
+        return usage("socket path too long");
+    strcpy(sa.sun_path, path);
+    unlink(path);
+    if (lfd < 0 || bind(lfd, reinterpret_cast<sockaddr *>(&sa), sizeof(sa)) || listen(lfd, 2)) {
+        perror("enc_qei_server: socket");
+        return 1;
+    }
+
+    Verilated::commandArgs(argc, argv);
+    top = new Venc_qei_wb;
+    channels = static_cast<int>(sizeof(top->a_in) * 8);
+    {
+        // the number of channels from CAPS, after reset
+        top->rst = 1;
+        for (int i = 0; i < 4; i++)
+            tick();
+        top->rst = 0;
+        tick();
+        uint32_t caps = 0;
+        access(4, false, &caps, 0xf);
+        channels = static_cast<int>((caps >> 22) & 0x1f);
+        if (channels < 1 || channels > kMaxChannels) {
+            fprintf(stderr, "enc_qei_server: CAPS 0x%08x names %d channels\n", caps, channels);
+            return 1;
+        }
+    }
+    for (int k = 0; k < channels; k++)
+        enc_stim_init(&stim[k], static_cast<unsigned>(k));
+    drive_inputs();
+    for (int i = 0; i < 64; i++)  // the input filters settle on the first state
+        tick();
+    const uint32_t addr_limit = 1u << ENC_QEI_ADDR_W;  // the bus port's byte-address bits
+
+    printf("enc_qei_server: %d channels, listening on %s\n", channels, path);
+    fflush(stdout);
+    int bus = accept(lfd, nullptr, nullptr);
+    int irq = accept(lfd, nullptr, nullptr);
+    if (bus < 0 || irq < 0) {
+        perror("enc_qei_server: accept");
+        return 1;
+    }
+    bool irq_reported = false;
+    uint64_t steps = 0, accesses = 0;
+    for (;;) {
+        uint32_t req[4], resp[2] = {0, 0};
+        if (!full_io(bus, req, sizeof(req), true))
+            break;
+        if (req[0] == kOpRead || req[0] == kOpWrite) {
+            uint32_t data = req[2];
+            accesses++;
+            if (req[1] >= addr_limit) {
+                resp[1] = 1;
+            } else {
+                resp[1] = access(req[1], req[0] == kOpWrite, &data, req[3]);
+                resp[0] = data;
+            }
+            if (req[0] == kOpRead && req[1] == 0 && id_override)
+                resp[0] = id_word;
+        } else if (req[0] == kOpAdvance) {
+            for (uint32_t i = 0; i < req[2]; i++) {
+                for (int k = 0; k < channels; k++)
+                    enc_stim_next(&stim[k]);
+                drive_inputs();
+                for (int c = 0; c < ENC_STIM_STEP_CLOCKS; c++)
+                    tick();
+            }
+            steps += req[2];
+        } else {
+            fprintf(stderr, "enc_qei_server: unknown request op %u\n", req[0]);
+            return 1;
+        }
+        if (top->irq && !irq_reported) {
+            char one = 1;
+            if (!full_io(irq, &one, 1, false))
+                break;
+        }
+        irq_reported = top->irq;
+        if (!full_io(bus, resp, sizeof(resp), false))
+            break;
+    }
+    printf("enc_qei_server: %llu accesses, %llu motion steps, %llu clocks\n",
+           static_cast<unsigned long long>(accesses), static_cast<unsigned long long>(steps),
+           static_cast<unsigned long long>(clocks));
+    top->final();
+    delete top;
+    unlink(path);
+    return 0;
+}

@@ -1,0 +1,238 @@
+# SPDX-License-Identifier: Apache-2.0
+"""enc_qei: when the global snapshot acts, to the clock, as doc/enc_qei.md and the RDL text of
+GSNAP_CTRL / GSNAP_PERIOD say it:
+
+- the clock of a CMD write's snapshot, counted one way for both buses: the *write clock* is the
+  first clock of the Wishbone strobe, or the clock of the later of the AXI4-Lite AW and W
+  handshakes; the snapshot is taken WB_LAT (Wishbone) or AXIL_LAT (AXI4-Lite) clocks after it,
+  which is the clock of wb_ack_o, or the clock before s_axil_bvalid rises; a channel's own
+  SNAP_CTRL.CMD takes its snapshot in the same clock;
+- PERIOD_EN written 1 while it is 1 does not restart the unit timer; a 0 -> 1 write starts it,
+  its first snapshot GSNAP_PERIOD ticks after the write's snapshot clock (the clock a CMD in that
+  write would take its snapshot);
+- a new GSNAP_PERIOD applies after the period in progress: the timer snapshot that ends it comes
+  at the old length, the next ones at the new; a write whose snapshot clock is less than
+  PERIOD_LAG clocks before the end of the period in progress applies one period later.
+
+The times are taken from the design: the timebase (TB_PRESCALE 0: one tick per clock) and the
+bus handshakes in every clock, and the global snapshot requests (the snapshot clocks). Runs on
+both builds of enctools.qei.env.CONFIGS, with random AXI4-Lite back-pressure.
+"""
+
+from __future__ import annotations
+
+import re
+
+import cocotb
+import pytest
+from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.regmap import pack
+from enctools.tb import cocotb_test
+
+WB_LAT = 3      # Wishbone: the snapshot clock is the strobe's first clock + 3 (after the ack)
+AXIL_LAT = 5    # AXI4-Lite: the later of the AW / W handshakes + 5 (the clock BVALID rises)
+RESP = {True: -1, False: 0}   # the response's first clock - the snapshot clock (Wishbone: True)
+TIMER_START = -1  # PERIOD_EN 0 -> 1: the timer counts from the clock before the write's snapshot
+PERIOD_LAG = 1  # a new GSNAP_PERIOD: used for periods that start after the write's snapshot clock
+
+
+class Trace:
+    """Per clock (sampled after each rising edge): the timebase, the global snapshot request, the
+    Wishbone strobe / acknowledge or the AXI4-Lite handshakes."""
+
+    def __init__(self, dut):
+        self.dut = dut
+        self.wb = hasattr(dut, "wb_stb_i")
+        self.rows = []
+        self.task = cocotb.start_soon(self._run())
+
+    def _sample(self) -> dict:
+        d = self.dut
+        row = {"tb": int(d.u_qei.timebase.value), "gsnap": int(d.u_qei.gsnap.value)}
+        if self.wb:
+            row["req"] = int(d.wb_cyc_i.value) & int(d.wb_stb_i.value)
+            row["resp"] = int(d.wb_ack_o.value) | int(d.wb_err_o.value)
+        else:
+            row["aw"] = int(d.s_axil_awvalid.value) & int(d.s_axil_awready.value)
+            row["w"] = int(d.s_axil_wvalid.value) & int(d.s_axil_wready.value)
+            row["resp"] = int(d.s_axil_bvalid.value)
+        return row
+
+    async def _run(self):
+        while True:
+            await RisingEdge(self.dut.clk)
+            await ReadOnly()
+            self.rows.append(self._sample())
+
+    def now(self) -> int:
+        return len(self.rows)
+
+    def first(self, key: str, after: int) -> int:
+        return next(i for i in range(after, len(self.rows)) if self.rows[i][key])
+
+    def write_clock(self, after: int) -> int:
+        """The clock the bus hands the peripheral the first write after clock ``after``."""
+        if self.wb:
+            return self.first("req", after)
+        return max(self.first("aw", after), self.first("w", after))
+
+    def clock_of(self, tb: int, after: int) -> int:
+        return next(i for i in range(after, len(self.rows)) if self.rows[i]["tb"] == tb)
+
+    def snapshots(self, after: int, before: int | None = None) -> list[int]:
+        """The clocks of the global snapshots in [after, before)."""
+        return [i for i in range(after, before or len(self.rows)) if self.rows[i]["gsnap"]]
+
+
+async def write(bus, trace: Trace, reg: str, value: int) -> tuple[int, int]:
+    """Write ``reg``; returns (write clock, response clock)."""
+    n0 = trace.now()
+    await bus.wr(reg, value)
+    await ClockCycles(bus.dut.clk, 2)
+    return trace.write_clock(n0), trace.first("resp", n0)
+
+
+@cocotb_test()
+async def cmd_snapshot_clock(dut):
+    """GSNAP_CTRL.CMD and a channel's SNAP_CTRL.CMD, twelve writes each at random distances:
+    the snapshot clock (where GSNAP_TIME / SNAP_TIME take the timebase) is the write clock +
+    WB_LAT or AXIL_LAT, the clock of the Wishbone acknowledge or the one before BVALID."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await bus.wr("TB_PRESCALE", 0)
+    trace = Trace(dut)
+    lat = WB_LAT if trace.wb else AXIL_LAT
+    found = {}
+    for reg, time_reg in (("GSNAP_CTRL", "GSNAP_TIME"), ("SNAP_CTRL", "SNAP_TIME")):
+        for _ in range(12):
+            await ClockCycles(dut.clk, rng.randint(1, 30))
+            n0 = trace.now()
+            wclk, rclk = await write(bus, trace, reg, pack(reg, CMD=1))
+            snap = trace.clock_of(await bus.rd(time_reg), n0)
+            found.setdefault(reg, set()).add((snap - wclk, rclk - snap))
+    dut._log.info("snapshot clock - write clock, response clock - snapshot clock: %s", found)
+    for reg, seen in found.items():
+        assert seen == {(lat, RESP[trace.wb])}, f"{reg}.CMD: {seen}"
+
+
+@cocotb_test()
+async def period_en_rewrite_and_restart(dut):
+    """The unit timer at GSNAP_PERIOD P: PERIOD_EN written 1 again (and CMD with it) at random
+    phases keeps every timer snapshot on the grid of the first one, P clocks apart; PERIOD_EN
+    written 0 and then 1 restarts it, the first snapshot P clocks after the write's snapshot
+    clock."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await bus.wr("TB_PRESCALE", 0)
+    trace = Trace(dut)
+    lat = WB_LAT if trace.wb else AXIL_LAT
+    for period in (rng.randint(60, 90), rng.randint(150, 200)):
+        await bus.wr("GSNAP_PERIOD", period)
+        wclk, _ = await write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+        start = wclk + lat + TIMER_START
+        rewrites = []
+        for _ in range(4):   # PERIOD_EN = 1 again, at random phases, once with a CMD
+            await ClockCycles(dut.clk, rng.randint(period // 3, 2 * period))
+            cmd = int(rng.random() < 0.3)
+            w, _ = await write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1, CMD=cmd))
+            rewrites.append((w + lat, cmd))   # (its snapshot clock, with a CMD)
+        await ClockCycles(dut.clk, 2 * period)
+        end = trace.now()
+        cmds = {c for c, with_cmd in rewrites if with_cmd}
+        timer = [i for i in trace.snapshots(start + 1, end) if i not in cmds]
+        assert len(timer) >= 5
+        assert [i - start for i in timer] == [period * (k + 1) for k in range(len(timer))], \
+            f"period {period}: timer snapshots at {[i - start for i in timer]} clocks after the " \
+            f"start; PERIOD_EN rewritten at {[c - start for c, _ in rewrites]}"
+        # 0, then 1: a restart
+        await ClockCycles(dut.clk, rng.randint(1, period))
+        await bus.wr("GSNAP_CTRL", 0)
+        await ClockCycles(dut.clk, rng.randint(0, 20))
+        n0 = trace.now()
+        wclk, _ = await write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+        await ClockCycles(dut.clk, period + 10)
+        first = trace.snapshots(n0)[0]
+        assert first - (wclk + lat + TIMER_START) == period, \
+            f"restart: first timer snapshot {first - (wclk + lat)} clocks after the write's " \
+            f"snapshot clock, GSNAP_PERIOD {period}"
+        await bus.wr("GSNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def new_period_after_the_one_in_progress(dut):
+    """GSNAP_PERIOD changed (P1 <-> P2) while the timer runs, the write's snapshot clock d clocks
+    before the end of the period in progress (aimed at d = -2 .. 11 and four random d): the timer
+    snapshot that ends it comes at the old length; the following period is the new one when
+    d >= PERIOD_LAG, else the old one once more; the one after that is the new one."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await bus.wr("TB_PRESCALE", 0)
+    trace = Trace(dut)
+    lat = WB_LAT if trace.wb else AXIL_LAT
+    p1, p2 = rng.randint(70, 90), rng.randint(100, 120)
+    await bus.wr("GSNAP_PERIOD", p1)
+    await write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+    await ClockCycles(dut.clk, 2 * p1 + 5)
+    p_cur, seen = p1, {}
+    aims = [*range(-2, 12), *(rng.randint(12, p1 - 20) for _ in range(4))]
+    # AXI4-Lite back-pressure moves a write by a few clocks: aim at the boundary until both of
+    # its sides were hit (at most 30 more writes)
+    boundary = [rng.randint(-1, 2) for _ in range(30)]
+    while aims:
+        aim = aims.pop(0)
+        if not aims and not (PERIOD_LAG - 1 in seen.get(False, ()) and
+                             PERIOD_LAG in seen.get(True, ())) and boundary:
+            aims.append(boundary.pop())
+        p_new = p2 if p_cur == p1 else p1
+        nxt = trace.snapshots(0)[-1] + p_cur
+        while nxt - aim - lat - 2 <= trace.now():
+            nxt += p_cur
+        while trace.now() < nxt - aim - lat - 1:   # the master starts a clock after it is asked
+            await RisingEdge(dut.clk)
+        n0 = trace.now()
+        wclk, _ = await write(bus, trace, "GSNAP_PERIOD", p_new)
+        await ClockCycles(dut.clk, 3 * max(p_cur, p_new) + 10)
+        wsnap = wclk + lat
+        snaps = trace.snapshots(n0 - p_cur - 5)
+        ends = [i for i in snaps if i >= wsnap]
+        prev = max(i for i in snaps if i < ends[0])
+        d = ends[0] - wsnap
+        gaps = [b - a for a, b in zip(ends, ends[1:])][:2]
+        seen.setdefault(d >= PERIOD_LAG, set()).add(d)
+        assert ends[0] - prev == p_cur, f"d {d}: the period in progress lasted {ends[0] - prev}, not {p_cur}"
+        expect = [p_new, p_new] if d >= PERIOD_LAG else [p_cur, p_new]
+        assert gaps == expect, f"d {d}: periods {gaps} after the write, expected {expect}"
+        p_cur = p_new
+    dut._log.info("d (write's snapshot clock to the end of the period) by 'new period next': %s", seen)
+    assert PERIOD_LAG - 1 in seen.get(False, ()) and PERIOD_LAG in seen.get(True, ()), \
+        f"the sweep missed the boundary: {seen}"
+
+
+# ---- pytest ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
+def test_gsnap_timing(top, count_w, ts_w):
+    run_feature(__name__, top, count_w, ts_w)
+
+
+def test_doc_and_rdl_say_the_measured_clocks():
+    """doc/enc_qei.md and the RDL text of GSNAP_CTRL give the clocks these tests measure: the
+    snapshot clock as the strobe's first clock + WB_LAT and the later handshake + AXIL_LAT, the
+    timer's first snapshot at the snapshot clock + GSNAP_PERIOD - 1."""
+    from enctools.paths import DOC
+    from enctools.regmap import nodes
+
+    glb = {r.inst_name: r for _, _, r in nodes()}["GSNAP_CTRL"]
+    texts = {"doc/enc_qei.md": (DOC / "enc_qei.md").read_text(),
+             "GSNAP_CTRL (RDL)": " ".join([glb.get_property("desc")] +
+                                          [f.get_property("desc") for f in glb.fields()])}
+    for where, text in texts.items():
+        text = " ".join(text.split())
+        wb = set(re.findall(r"strobe(?:'s)? first clock \+ (\d+)|first clock of the strobe \+ (\d+)", text))
+        axil = set(re.findall(r"handshakes?(?: clocks)? \+ (\d+)", text))
+        assert {int(a or b) for a, b in wb} == {WB_LAT}, f"{where}: Wishbone snapshot clock {wb}"
+        assert {int(x) for x in axil} == {AXIL_LAT}, f"{where}: AXI4-Lite snapshot clock {axil}"
+        assert re.search(r"snapshot clock \+ GSNAP_PERIOD [-−] 1|snapshot clock \+ `GSNAP_PERIOD` [-−] 1",
+                         text), f"{where}: the timer's first snapshot"
+        assert "three clocks after its bus request" not in text
