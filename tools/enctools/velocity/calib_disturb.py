@@ -5,17 +5,17 @@ to the estimator (``learn_revs`` as the bench) and to the same estimator without
 uncalibrated readings), reads both at 1 kHz and scores them over one-second windows
 (:func:`window_ratios`).
 
-A case is a function ``(unit, rng, cpr) -> Run``: the waveform (or waveform pair, spliced), the
-shaft's true motion (a Profile) and the entry-stream fault, if any. The same cases run on the
-bench's 500-cycle units (make velocity) and on small units in tb/velocity (their tests hold the
-goal on a few cheap ones).
+A case is a function ``(unit, rng) -> Run``: the waveform (two units' spliced, for a slipped
+hub or another wheel), the shaft's true motion (a Profile) and the entry-stream fault, if any.
+The bench (make velocity) runs every case on its four non-ideal units; tb/velocity holds the
+goal on a few of them.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from .config import DETUNE, READ_HZ
 
@@ -30,7 +30,7 @@ GOAL_RATIO = 1.10         # calibrated rms <= 1.10 x uncalibrated rms, every win
 class Run:
     """What a case builds: ``wf`` (waveform, index) pair, ``truth`` the shaft's Profile,
     ``event_s`` when the disturbance happens (None: it is the whole run), ``fault`` a function
-    (entries, ticks, rng) -> (entries, ticks) applied to the entry stream, ``what`` a
+    (entries, ticks, timebase, rng) -> (entries, ticks) applied to the entry stream, ``what`` a
     description."""
 
     wf: tuple
@@ -38,14 +38,9 @@ class Run:
     event_s: float | None
     what: str
     fault: object = None
-    extra: dict = field(default_factory=dict)
 
 
 # ---------------------------------------------------------------------------- motion helpers
-def _rev_s(rpm: float) -> float:
-    return 60.0 / abs(rpm)
-
-
 def speed_wave(p, rpm0: float, frac: float, period_s: float, seconds: float, steps: int = 48):
     """Append a speed ``rpm0 (1 + frac sin(2 pi t / period_s))`` for ``seconds``, as ramps of
     ``period_s / steps`` each (the model's profiles are piecewise constant acceleration)."""
