@@ -793,8 +793,8 @@ module enc_qei_engine #(
   // A request is taken into b_* registers. A write goes into its channel's slot when the slot is
   // free (a COUNT_LO write after reading COUNT and the staged word: it is put there whole); a
   // read waits until the channel has no write waiting, then reads the memory's port b.
-  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_READ = 3'd2, B_CNT = 3'd3, B_HI = 3'd4,
-                   B_POST = 3'd5, B_DONE = 3'd6;
+  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_READ = 3'd2, B_CNT = 3'd3, B_HIRD = 3'd4,
+                   B_HI = 3'd5, B_POST = 3'd6, B_DONE = 3'd7;
   reg  [2:0]      b_st_q;
   reg             b_wr_q;
   reg  [CH_W-1:0] b_ch_q;
@@ -847,12 +847,15 @@ module enc_qei_engine #(
 
   always @(*) begin
     case (b_st_q)
-      B_CNT:   b_addr = W_HI;   // (B_WAIT -> B_CNT read W_CNT; B_CNT reads the staged word)
+      B_HIRD:  b_addr = W_HI;   // (a COUNT_LO write: B_WAIT reads W_CNT, B_HIRD the staged word)
       default: b_addr = (b_wr_q) ? W_CNT : word_of(b_word_q);
     endcase
   end
 
   assign raddr_b = {b_ch_q, b_addr};
+  // port b must not read the word written in the same clock (enc_qei_ram: undefined); B_CNT then
+  // reads its word again, with the count's low word it got last clock (not yet taken)
+  wire b_clash = we & (waddr == raddr_b);
 
   // a register's value from its word
   function [31:0] reg_of;
@@ -923,7 +926,7 @@ module enc_qei_engine #(
               pend_set    <= onehot(lat_ch_q);
               lat_valid_q <= 1'b0;
             end
-          end else if (~b_pend) begin
+          end else if (~b_pend & ~b_clash) begin
             // port b reads the register's word (a COUNT_LO write: COUNT) now, for the next clock
             if (b_wr_q & b_cnt_lo & (|b_wstrb_q)) begin
               b_st_q <= B_CNT;
@@ -934,9 +937,14 @@ module enc_qei_engine #(
             end
           end
         end
-        B_CNT: begin  // the count's low word is here; port b reads the staged word now
+        B_CNT: begin  // the count's low word is here
           b_cnt_q <= b_fresh ? 32'd0 : rdata_b[31:0];
-          b_st_q  <= B_HI;
+          b_st_q  <= B_HIRD;
+        end
+        B_HIRD: begin  // port b reads the staged word now
+          if (~b_clash) begin
+            b_st_q <= B_HI;
+          end
         end
         B_HI: begin  // the staged word is here
           pend_we    <= 1'b1;
