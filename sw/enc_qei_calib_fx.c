@@ -145,20 +145,6 @@ static wd_t wd_shl(const wd_t *a, unsigned n)
     return r;
 }
 
-/* a / 2^n for a >= 0, 0 <= n < 192 */
-static wd_t wd_shr(const wd_t *a, unsigned n)
-{
-    wd_t r;
-    int i, k = (int)(n / 32u);
-    unsigned s = n % 32u;
-    memset(&r, 0, sizeof r);
-    for (i = 0; i + k < WL; i++) {
-        uint32_t lo = a->v[i + k], hi = i + k + 1 < WL ? a->v[i + k + 1] : 0u;
-        r.v[i] = s ? (lo >> s) | (hi << (32u - s)) : lo;
-    }
-    return r;
-}
-
 /* bits of a non-negative a (0 for 0) */
 static unsigned wd_bits(const wd_t *a)
 {
@@ -183,6 +169,18 @@ static wd_t wd_udiv(const wd_t *n, const wd_t *d, wd_t *rem)
     int i;
     memset(&q, 0, sizeof q);
     memset(&r, 0, sizeof r);
+    if (wd_bits(d) <= 32u) {                 /* limb by limb */
+        uint64_t c = 0;
+        for (i = WL - 1; i >= 0; i--) {
+            c = (c << 32) | n->v[i];
+            q.v[i] = (uint32_t)(c / d->v[0]);
+            c -= (uint64_t)q.v[i] * d->v[0];
+        }
+        r.v[0] = (uint32_t)c;
+        if (rem != NULL)
+            *rem = r;
+        return q;
+    }
     for (i = (int)wd_bits(n) - 1; i >= 0; i--) {
         r = wd_shl(&r, 1u);
         r.v[0] |= (n->v[i / 32] >> (i % 32)) & 1u;
@@ -217,53 +215,35 @@ static uint64_t wd_div_round(const wd_t *n, const wd_t *d)
     return x;
 }
 
-/* floor(sqrt(a)) for 0 <= a < 2^128; UINT64_MAX beyond */
+/* floor(sqrt(a)) for 0 <= a < 2^128 (digit by digit, in two 64-bit halves); UINT64_MAX
+ * beyond */
 static uint64_t wd_isqrt(const wd_t *a)
 {
-    uint64_t x = 0;
-    int b;
-    if (wd_bits(a) > 128u)
+    uint64_t xh, xl, rh = 0, rl = 0, oh, ol;
+    unsigned b = wd_bits(a), e;
+    if (b > 128u)
         return UINT64_MAX;
-    for (b = 63; b >= 0; b--) {
-        uint64_t y = x | ((uint64_t)1 << b);
-        wd_t yy = wd_u64(y);
-        yy = wd_mul(&yy, &yy);
-        if (wd_ucmp(&yy, a) <= 0)
-            x = y;
+    if (b == 0u)
+        return 0u;
+    xl = ((uint64_t)a->v[1] << 32) | a->v[0];
+    xh = ((uint64_t)a->v[3] << 32) | a->v[2];
+    e = (b - 1u) & ~1u;                      /* one = 4^(e/2), the highest power of 4 <= a */
+    oh = e >= 64u ? (uint64_t)1 << (e - 64u) : 0u;
+    ol = e >= 64u ? 0u : (uint64_t)1 << e;
+    while (oh | ol) {
+        uint64_t tl = rl + ol, th = rh + oh + (tl < rl);
+        rl = (rl >> 1) | (rh << 63);         /* res >>= 1 */
+        rh >>= 1;
+        if (xh > th || (xh == th && xl >= tl)) {
+            xh = xh - th - (xl < tl);
+            xl -= tl;
+            rl += ol;
+            rh += oh + (rl < ol);
+        }
+        ol = (ol >> 2) | (oh << 62);         /* one >>= 2 */
+        oh >>= 2;
     }
-    return x;
-}
-
-/* round(num / den) for num >= 0, den > 0, saturated at QEI_CALFX_MAX: one 64-bit division of
- * the leading bits, then corrected with the exact remainder */
-static uint32_t div_round_sat(const wd_t *num, const wd_t *den)
-{
-    wd_t n2 = wd_shl(num, 1u), d2 = wd_shl(den, 1u), lim, r, t;
-    unsigned k;
-    uint64_t q, nn, dd;
-    wd_add(&n2, den);                       /* (2 num + den) / (2 den): round half up */
-    lim = wd_shl(&d2, 31u);
-    if (wd_ucmp(&n2, &lim) >= 0)
-        return QEI_CALFX_MAX;
-    k = wd_bits(&d2) > 32u ? wd_bits(&d2) - 32u : 0u;
-    t = wd_shr(&n2, k);                     /* < 2^63: the quotient is < 2^31 */
-    nn = wd_to_u64(&t);
-    t = wd_shr(&d2, k);                     /* < 2^32 */
-    dd = wd_to_u64(&t);
-    q = nn / dd;
-    t = wd_u64(q);
-    t = wd_mul(&t, &d2);
-    r = n2;
-    wd_sub(&r, &t);                         /* n2 - q d2, corrected to 0 <= r < d2 */
-    while (wd_negative(&r)) {
-        q--;
-        wd_add(&r, &d2);
-    }
-    while (wd_ucmp(&r, &d2) >= 0) {
-        q++;
-        wd_sub(&r, &d2);
-    }
-    return q > (uint64_t)QEI_CALFX_MAX ? QEI_CALFX_MAX : (uint32_t)q;
+    return rl;
 }
 
 /* ----------------------------------------------------------------------- 64-bit helpers */
@@ -307,7 +287,7 @@ static int64_t clamp64(int64_t x, int64_t lim)
 static int64_t div_round_i64(int64_t a, uint32_t n)
 {
     uint64_t ua = a < 0 ? (uint64_t)0 - (uint64_t)a : (uint64_t)a;
-    uint64_t q = ua / n, r = ua % n;
+    uint64_t q = ua / n, r = ua - q * n;
     if (2u * r >= n)
         q++;
     return a < 0 ? -(int64_t)q : (int64_t)q;
@@ -317,7 +297,14 @@ static int64_t div_round_i64(int64_t a, uint32_t n)
 
 static int64_t mod_s(int64_t x, int64_t s)
 {
-    int64_t r = x % s;
+    int64_t r;
+    if (x >= 0 && x < s)                     /* the usual cases without a 64-bit division */
+        return x;
+    if (x >= s && x < 2 * s)
+        return x - s;
+    if (x < 0 && x >= -s)
+        return x + s;
+    r = x % s;
     return r < 0 ? r + s : r;
 }
 
@@ -401,11 +388,23 @@ static void abort_rev(qei_calfx_t *st)
     st->t_prev2 = 0;
 }
 
-/* x * y as a wd_t (the squares and products of the agreement sums) */
-static void wd_mac(wd_t *acc, int64_t x, int64_t y)
+/* acc += x^2, the sum within 2^128 (the agreement sums) */
+static void sq_acc(uint64_t acc[2], int64_t x)
 {
-    wd_t a = wd_i64(x), b = wd_i64(y), p = wd_mul(&a, &b);
-    wd_add(acc, &p);
+    const uint64_t M = 0xFFFFFFFFu;
+    uint64_t u = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
+    uint64_t a0 = u & M, a1 = u >> 32, p0 = a0 * a0, p1 = a0 * a1, p2 = a1 * a1;
+    uint64_t lo = p0 + (p1 << 33), hi = p2 + (p1 >> 31) + (lo < p0);
+    acc[0] += lo;
+    acc[1] += hi + (acc[0] < lo);
+}
+
+static wd_t wd_u128(const uint64_t a[2])
+{
+    wd_t r = wd_u64(a[0]);
+    r.v[2] = (uint32_t)a[1];
+    r.v[3] = (uint32_t)(a[1] >> 32);
+    return r;
 }
 
 /* figure <= tol / 10^6 counts, the figure's square being num / scale in 2^-64 counts^2:
@@ -432,9 +431,9 @@ static int agrees(qei_calfx_t *st, const int64_t *ref, uint32_t n)
 {
     const int64_t S = st->S, N = st->S / 4;
     const int64_t *w = st->work;
-    int64_t c, sm = 0, prev[4] = {0, 0, 0, 0}, nh = 0;
-    wd_t zero = wd_u64(0), smm = zero, sxm = zero, e2 = zero, sh = zero, shh = zero;
-    wd_t A, B, t, sx2;
+    int64_t c, sm = 0, sh = 0, prev[4] = {0, 0, 0, 0}, nh = 0;
+    uint64_t q_e2[2] = {0, 0}, q_smm[2] = {0, 0}, q_shh[2] = {0, 0};
+    wd_t zero = wd_u64(0), sxm = zero, smm, e2, shh, A, B, t, sx2;
     int ok;
     for (c = 0; c < N; c++) {
         int64_t d[4], M;
@@ -450,21 +449,24 @@ static int agrees(qei_calfx_t *st, const int64_t *ref, uint32_t n)
         }
         M = d[0] + d[1] + d[2] + d[3];
         for (k = 0; k < 4; k++) {
-            int64_t j = 4 * c + k, E = 4 * d[k] - M;
-            wd_mac(&e2, E, E);
+            int64_t j = 4 * c + k;
+            sq_acc(q_e2, 4 * d[k] - M);
             if (j >= 4 && (int)(j & 1) == st->a_par) {
                 int64_t h = d[k] - prev[k];
-                t = wd_i64(h);
-                wd_add(&sh, &t);
-                wd_mac(&shh, h, h);
+                sh += h;
+                sq_acc(q_shh, h);
                 nh++;
             }
             prev[k] = d[k];
         }
         sm += M;
-        wd_mac(&smm, M, M);
-        wd_mac(&sxm, 2 * c - (N - 1), M);
+        sq_acc(q_smm, M);
+        t = wd_i64((2 * c - (N - 1)) * M);
+        wd_add(&sxm, &t);
     }
+    smm = wd_u128(q_smm);
+    e2 = wd_u128(q_e2);
+    shh = wd_u128(q_shh);
     /* shape: 16 2^64 r2 = sum M^2 - (sum M)^2 / N - (sum X M)^2 / sum X^2 */
     t = wd_i64(sm);
     t = wd_mul(&t, &t);
@@ -481,7 +483,8 @@ static int agrees(qei_calfx_t *st, const int64_t *ref, uint32_t n)
         smm = zero;
     /* line: 2^64 line^2 = (n sum h^2 - (sum h)^2) / n^2 */
     shh = wd_mul_u64(&shh, (uint64_t)nh);
-    t = wd_mul(&sh, &sh);
+    t = wd_i64(sh);
+    t = wd_mul(&t, &t);
     wd_sub(&shh, &t);
     if (wd_negative(&shh))
         shh = zero;
@@ -907,13 +910,62 @@ void qei_calfx_push(qei_calfx_t *st, const qei_calfx_entry_t *e)
     }
 }
 
-/* |ang| (2^-32 counts) over dt ticks in 2^-F count/s: round(|ang| tick_hz 2^F / (dt 2^32)) */
+/* 128-bit unsigned a >= b, a - b, a + b on (hi, lo) pairs, for rate() */
+static int ge128(uint64_t ah, uint64_t al, uint64_t bh, uint64_t bl)
+{
+    return ah > bh || (ah == bh && al >= bl);
+}
+
+static void sub128(uint64_t *ah, uint64_t *al, uint64_t bh, uint64_t bl)
+{
+    *ah -= bh + (*al < bl);
+    *al -= bl;
+}
+
+static void add128(uint64_t *ah, uint64_t *al, uint64_t bh, uint64_t bl)
+{
+    *al += bl;
+    *ah += bh + (*al < bl);
+}
+
+/* |ang| (2^-32 counts) over dt ticks (> 0) in 2^-F count/s, rounded (ties up), saturated at
+ * QEI_CALFX_MAX: q = (2 num + den) / (2 den), num = |ang| tick_hz < 2^95, den = dt 2^(32-F)
+ * < 2^96; q from one 64-bit division of the leading bits, corrected with the exact remainder */
 static uint32_t rate(const qei_calfx_t *st, int64_t ang, uint64_t dt)
 {
-    wd_t num = wd_u64(ang < 0 ? (uint64_t)0 - (uint64_t)ang : (uint64_t)ang), den = wd_u64(dt);
-    num = wd_mul_u64(&num, st->cfg.tick_hz);
-    den = wd_shl(&den, 32u - st->cfg.frac_bits);
-    return div_round_sat(&num, &den);
+    const uint64_t M = 0xFFFFFFFFu;
+    const unsigned s = 32u - st->cfg.frac_bits;
+    uint64_t a = ang < 0 ? (uint64_t)0 - (uint64_t)ang : (uint64_t)ang;
+    uint64_t p0 = (a & M) * st->cfg.tick_hz, p1 = (a >> 32) * st->cfg.tick_hz;
+    uint64_t nl = p0 + (p1 << 32), nh = (p1 >> 32) + (nl < p0);
+    uint64_t dl = dt << s, dh = dt >> (64u - s);
+    uint64_t lh, ll, ph, pl, q, qd0, qd1, k = 0;
+    add128(&nh, &nl, nh, nl);                /* 2 num + den, 2 den */
+    add128(&nh, &nl, dh, dl);
+    add128(&dh, &dl, dh, dl);
+    lh = (dh << 31) | (dl >> 33);            /* 2 den 2^31 < 2^128 */
+    ll = dl << 31;
+    if (ge128(nh, nl, lh, ll))
+        return QEI_CALFX_MAX;
+    while ((dh >> k) != 0u || ((dh << (63u - k) << 1) | (dl >> k)) >> 32)
+        k++;                                 /* (2 den) >> k < 2^32 */
+    q = k ? ((nh << (64u - k)) | (nl >> k)) / ((dh << (64u - k)) | (dl >> k)) : nl / dl;
+    qd0 = (dl & M) * q;                      /* q 2 den, q < 2^33 */
+    qd1 = (dl >> 32) * q;
+    pl = qd0 + (qd1 << 32);
+    ph = dh * q + (qd1 >> 32) + (pl < qd0);
+    while (!ge128(nh, nl, ph, pl)) {
+        q--;
+        sub128(&ph, &pl, dh, dl);
+    }
+    lh = nh;
+    ll = nl;
+    sub128(&lh, &ll, ph, pl);
+    while (ge128(lh, ll, dh, dl)) {
+        q++;
+        sub128(&lh, &ll, dh, dl);
+    }
+    return q > (uint64_t)QEI_CALFX_MAX ? QEI_CALFX_MAX : (uint32_t)q;
 }
 
 qei_calfx_reading_t qei_calfx_read(qei_calfx_t *st, uint32_t time)

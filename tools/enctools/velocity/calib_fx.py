@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -204,3 +205,99 @@ def summary(results) -> dict:
             "worst_run": worst[0] if worst else None,
             "mismatches": [(n, c.mismatch, c.mismatch_figures) for n, c in results if c.mismatch],
             "zero_bad": sum(c.zero_bad for _, c in results)}
+
+
+# ----------------------------------------------------------------------------- cost on RV32IM
+
+COST_C = TOP / "tb" / "velocity" / "calibfx_cost.c"
+RV_GCC = "riscv64-unknown-elf-gcc"
+RV_FLAGS = ["-march=rv32im", "-mabi=ilp32", "-O2", "-ffreestanding", "-nostdlib",
+            "-nostartfiles", "-Wl,-Ttext=0", "-Wl,-e,_start"]
+SHIMS = {"string.h": "#include <stddef.h>\nvoid *memset(void *d, int c, size_t n);\n",
+         "math.h": "double sqrt(double x);\n#define fabs __builtin_fabs\n"}
+
+
+def build_cost(out_dir: Path, double: bool = False) -> Path:
+    """The bare-metal cost program (tb/velocity/calibfx_cost.c) for RV32IM, with the integer
+    estimator or (``double``) the double one in software floating point."""
+    gcc = shutil.which(RV_GCC)
+    if gcc is None:
+        raise RuntimeError(f"{RV_GCC} not found (Debian: gcc-riscv64-unknown-elf)")
+    inc = out_dir / "shim"
+    inc.mkdir(parents=True, exist_ok=True)
+    for name, text in SHIMS.items():
+        (inc / name).write_text(text)
+    src = SW / ("enc_qei_calib.c" if double else "enc_qei_calib_fx.c")
+    out = out_dir / ("calib_cost_double.elf" if double else "calib_cost_fx.elf")
+    cmd = [gcc, *RV_FLAGS, f"-I{inc}", f"-I{SW}", *(["-DCOST_DOUBLE"] if double else []),
+           str(COST_C), str(src), "-lgcc", "-o", str(out)]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        raise RuntimeError(f"{RV_GCC} failed:\n{' '.join(cmd)}\n{res.stderr}")
+    return out
+
+
+def soft_float_calls(elf: Path) -> list[str]:
+    """libgcc's soft-float routines the program links (riscv64-unknown-elf-nm)."""
+    nm = shutil.which("riscv64-unknown-elf-nm")
+    res = subprocess.run([nm, str(elf)], capture_output=True, text=True, check=True)
+    pat = re.compile(r"^__(add|sub|mul|div|neg|cmp|eq|ne|lt|le|gt|ge|unord|extend|trunc|fix|float)"
+                     r"\w*[sdt]f\w*$")
+    return sorted({ln.split()[-1] for ln in res.stdout.splitlines()
+                   if pat.match(ln.split()[-1])})
+
+
+def cost(elf: Path, cfg, ops, frac_bits: int = 8) -> dict:
+    """Run ``ops`` through the cost program in :class:`.rv32.Sim`: per kind of call (``read``,
+    ``entry``: a push that crosses no revolution boundary, ``boundary``: one that does, where
+    a completed revolution is learnt and checked) the largest instruction count with its
+    multiplications and divisions, the mean and the number of calls; ``readings``: [(mt_a,
+    any, calibrated)] per read; ``total``: the whole run's counts."""
+    from .rv32 import Sim
+
+    sim = Sim(elf)
+    words = [0, tick_hz_of(cfg.tick_s), frac_bits, cfg.ts_w, cfg.cycles, int(cfg.use_index),
+             cfg.learn_revs, cfg.stall_ticks & 0xFFFFFFFF, cfg.stall_ticks >> 32,
+             millionths(cfg.motion_tol), millionths(cfg.shape_tol), millionths(cfg.line_tol),
+             millionths(cfg.edge_tol)]
+    n_reads = 0
+    for kind, x in ops:
+        if kind == "E":
+            words += [int(x.a) | int(x.b) << 1 | int(x.up) << 2 | int(x.lost) << 3
+                      | int(x.idx) << 4, x.time]
+        else:
+            words += [1 << 31, x]
+            n_reads += 1
+    words[0] = len(ops)
+    sim.write_words(0x400000, words)
+    code = sim.run()
+    if code != 0:
+        raise RuntimeError(f"cost program exited {code}")
+    # MARK k, the call (a push ends with MARK 0x80000000 | boundaries so far), MARK k + 1
+    out = {"read": [], "entry": [], "boundary": []}
+    marks = sim.marks
+    i, revs = 0, 0
+    for k, (kind, _) in enumerate(ops):
+        if marks[i][0] != k:
+            raise RuntimeError(f"cost program: mark {marks[i][0]:#x} where op {k} starts")
+        nxt = marks[i + 1]
+        cost_k = (nxt[1] - marks[i][1], nxt[2] - marks[i][2], nxt[3] - marks[i][3])
+        if kind == "R":
+            out["read"].append(cost_k)
+            i += 1
+        else:
+            r = nxt[0] & 0x7FFFFFFF
+            out["boundary" if r != revs else "entry"].append(cost_k)
+            revs = r
+            i += 2
+    res = {}
+    for key, v in out.items():
+        if v:
+            worst = max(v)
+            res[key] = {"max": worst[0], "max_mul": worst[1], "max_div": worst[2],
+                        "mean": sum(c[0] for c in v) / len(v), "count": len(v)}
+    raw = sim.read_words(0x600000, 3 * n_reads)
+    res["readings"] = [tuple(x - (1 << 32) if x >> 31 else x for x in raw[j:j + 3])
+                       for j in range(0, len(raw), 3)]
+    res["total"] = dict(sim.counts)
+    return res
