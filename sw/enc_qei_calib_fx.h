@@ -9,7 +9,7 @@
  * the same checks in use, the same fallback to uncalibrated readings, the same IDX / LOST / missed
  * handling, every integer step taken in the same order. tb/velocity/test_velocity_calib_fx.py
  * runs both on the same entry streams and compares every reading and, after every entry, every
- * counter and flag.
+ * counter, flag and vote fraction.
  *
  * Readings (qei_calfx_reading_t): int32_t in units of 2^-F count steps per second, F =
  * cfg.frac_bits (0 .. 31), rounded to the nearest unit (ties up), as sw/enc_qei_velocity_fx.h:
@@ -29,14 +29,17 @@
  * millionths), the edge check (the residuals of the constant-acceleration extrapolation as exact
  * rationals) and the vote fractions (2^-62). They can differ from the double version's only
  * where a figure lies within the tables' difference (about 1e-9 counts) or the double's own
- * rounding (1e-16 relative) of its threshold; the test counts such differences (none on the
- * bench's runs). Where the double version has no limit this one has these:
+ * rounding (1e-16 relative) of its threshold. With a coarse tick (a count a few ticks long) the
+ * deviations are simple fractions and an edge-check vote can land exactly on its threshold:
+ * such ties go either way (the vote fractions differ by 1/32 until later votes bring them back
+ * together); tb/velocity counts them. At the bench's 10 ns tick there were none. Where the
+ * double version has no limit this one has these:
  *   - a revolution of 2^32 ticks or more (43 s at 100 MHz: below 1.4 rpm) is not clean;
  *   - a revolution whose fit needs an acceleration term beyond 2^30 counts (only with a motion
  *     tolerance far above 1e-3) is not clean;
  *   - a boundary that deviates from its reference by 256 counts or more disagrees;
- *   - the learning pass's sums saturate at +-2^31 counts per boundary;
- *   - an angle between a reading's two edges of 2^31 counts or more saturates.
+ *   - the learning pass's sums saturate at +-2^31 counts per boundary, the table at 2^29;
+ *   - an angle of 2^31 counts or more between two edges saturates.
  *
  * Use (N = 500 cycles, 100 MHz timebase, readings in 1/256 count/s):
  *   static int64_t buf[QEI_CALFX_BUF_LEN(500)];       3 x 4N int64_t: table, pass, revolution

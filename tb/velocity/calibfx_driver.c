@@ -6,11 +6,14 @@
  *                 tick_hz frac_bits motion_ppm shape_uc line_uc edge_uc
  *         then    "E time a b up lost idx" (an entry) or "R time" (a read)
  * stdout: per read "mt_a any calibrated" of the double (%.17g) and of the integer version;
- *         "M entry field double integer" once, at the first entry after which a counter or a
- *         flag differs (comparing stops there), followed by "F" and both versions' figures
+ *         "M entry field double integer" once, at the first entry after which a counter, a
+ *         flag or a vote fraction (by more than 1e-9) differs (comparing stops there),
+ *         except a vote decided within TIE of a threshold by the double version (a tie):
+ *         "T entry field margin", the integer version's fraction set to the double's, and on; followed by "F" and both versions' figures
  *         then (shape line edge motion frac_fine frac_coarse, the integer's scaled to doubles
  *         here, in the test driver); at the end "S entries" and the figures line "F". */
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -53,6 +56,44 @@ static void fields_fx(const qei_calfx_t *s, long v[NFIELDS])
     v[17] = qei_calfx_calibrated(s);
 }
 
+#define TIE 1e-7   /* a vote decided within this (relative, or counts) of its threshold */
+
+/* angle(b2) - angle(b1) with the double's table */
+static double cal_diff(const qei_cal_t *s, int64_t b2, int64_t b1)
+{
+    int64_t j2 = ((b2 - s->ref) % s->S + s->S) % s->S, j1 = ((b1 - s->ref) % s->S + s->S) % s->S;
+    return (double)(b2 - b1 - (j2 - j1)) + (s->table[j2] - s->table[j1]);
+}
+
+static double gap(double a, double b)
+{
+    double m = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
+    return fabs(a - b) / (m > 1.0 ? m : 1.0);
+}
+
+/* how close the double's edge-check sample of spacing k at (b, t), from the state before the
+ * entry, came to each of its thresholds (jolt, no objection, seen, worse): the least gap */
+static double vote_margin(const qei_cal_t *s, int k, int64_t b, uint64_t t)
+{
+    const int64_t *hb = s->ea_b[k];
+    const uint64_t *ht = s->ea_t[k];
+    double tau1 = (double)(ht[1] - ht[0]), tau2 = (double)(ht[2] - ht[0]),
+           tau3 = (double)(t - ht[0]), l1, l2, er, ec, eff, m;
+    l1 = tau3 * (tau3 - tau2) / (tau1 * (tau1 - tau2));
+    l2 = tau3 * (tau3 - tau1) / (tau2 * (tau2 - tau1));
+    er = (double)(b - hb[0]) - ((double)(hb[1] - hb[0]) * l1 + (double)(hb[2] - hb[0]) * l2);
+    ec = cal_diff(s, b, hb[0]) - (cal_diff(s, hb[1], hb[0]) * l1 + cal_diff(s, hb[2], hb[0]) * l2);
+    eff = fabs(er - ec);
+    m = gap(fabs(ec), 0.5);
+    if (gap(eff, 4.0 * fabs((double)(b - hb[0])) / tau3) < m)
+        m = gap(eff, 4.0 * fabs((double)(b - hb[0])) / tau3);
+    if (gap(fabs(er) < fabs(ec) ? fabs(er) : fabs(ec), 3.0 * eff) < m)
+        m = gap(fabs(er) < fabs(ec) ? fabs(er) : fabs(ec), 3.0 * eff);
+    if (gap(fabs(ec), fabs(er)) < m)
+        m = gap(fabs(ec), fabs(er));
+    return m;
+}
+
 static double q32(uint64_t x)
 {
     return x == UINT64_MAX ? -1.0 : (double)x / 4294967296.0;
@@ -70,7 +111,7 @@ int main(void)
 {
     qei_cal_cfg_t cfg;
     qei_calfx_cfg_t fx;
-    qei_cal_t st;
+    qei_cal_t st, before;
     qei_calfx_t sf;
     double *buf;
     int64_t *fbuf;
@@ -115,6 +156,7 @@ int main(void)
             e.up = ef.up = (uint8_t)up;
             e.lost = ef.lost = (uint8_t)lost;
             e.idx = ef.idx = (uint8_t)idx;
+            before = st;
             qei_cal_push(&st, &e);
             qei_calfx_push(&sf, &ef);
             if (same) {
@@ -128,6 +170,19 @@ int main(void)
                         figures(&st, &sf);
                         same = 0;
                         break;
+                    }
+                for (i = 0; same && i < 2; i++)   /* the vote fractions: a vote taken apart */
+                    if (fabs(st.frac[i] - (double)sf.frac[i] / 4611686018427387904.0) > 1e-9) {
+                        double m = vote_margin(&before, (int)i, st.m[1].last_b, st.m[1].last_t);
+                        if (m <= TIE) {       /* a tie at a threshold: count it, then resync */
+                            printf("T %ld %s %.3g\n", entries, i ? "frac_coarse" : "frac_fine", m);
+                            sf.frac[i] = (uint64_t)(st.frac[i] * 4611686018427387904.0 + 0.5);
+                            continue;
+                        }
+                        printf("M %ld %s %ld %ld\n", entries, i ? "frac_coarse" : "frac_fine",
+                               (long)(st.frac[i] * 1e9), (long)(sf.frac[i] >> 32));
+                        figures(&st, &sf);
+                        same = 0;
                     }
             }
             entries++;
