@@ -29,11 +29,14 @@ int enc_qei_drv_init(enc_qei_dev_t *d, volatile enc_qei_t *regs)
     if ((version >> 8) != 1u || (version & 0xFFu) < 2u)
         return ENC_QEI_DRV_EVERSION;
     if (ENC_QEI__CAPS__CHANNELS_GET(caps) < 1u ||
-        ENC_QEI__CAPS__CHANNELS_GET(caps) > ENC_QEI_CHANNELS_MAX)
+        ENC_QEI__CAPS__CHANNELS_GET(caps) > ENC_QEI_CHANNELS_MAX ||
+        ENC_QEI__CAPS__COUNT_W_GET(caps) < 1u || ENC_QEI__CAPS__COUNT_W_GET(caps) > 64u ||
+        ENC_QEI__CAPS__TS_W_GET(caps) > 32u)
         return ENC_QEI_DRV_ECAPS;
     d->channels = ENC_QEI__CAPS__CHANNELS_GET(caps);
     d->profile = ENC_QEI__CAPS__PROFILE_GET(caps);
     d->count_w = ENC_QEI__CAPS__COUNT_W_GET(caps);
+    d->count_mask = d->count_w >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << d->count_w) - 1u;
     d->ts_w = ENC_QEI__CAPS__TS_W_GET(caps);
     d->efifo_log2 = ENC_QEI__CAPS__EFIFO_LOG2_GET(caps);
     d->has_timing = (int)ENC_QEI__CAPS__TIMING_GET(caps);
@@ -55,23 +58,13 @@ const char *enc_qei_drv_strerror(int err)
     case ENC_QEI_DRV_OK: return "ok";
     case ENC_QEI_DRV_ENODEV: return "no enc_qei (ID.MAGIC)";
     case ENC_QEI_DRV_EVERSION: return "register map not 1.2 or a later 1.x (ID.VERSION)";
-    case ENC_QEI_DRV_ECAPS: return "CAPS.CHANNELS out of 1..16";
+    case ENC_QEI_DRV_ECAPS: return "CAPS out of range (CHANNELS 1..16, COUNT_W 1..64, TS_W <= 32)";
     case ENC_QEI_DRV_EINVAL: return "no such channel";
     case ENC_QEI_DRV_ENOTSUP: return "no timing unit in this build (CAPS.TIMING)";
     case ENC_QEI_DRV_ETIMEDOUT: return "no SNAP_READY";
     case ENC_QEI_DRV_ESKEW: return "SNAP_TIME differs from GSNAP_TIME";
     default: return "unknown error";
     }
-}
-
-int64_t enc_qei_drv_signed(const enc_qei_dev_t *d, uint64_t count)
-{
-    if (d->count_w < 64u) {
-        count &= ((uint64_t)1 << d->count_w) - 1u;
-        if ((count >> (d->count_w - 1u)) & 1u)
-            count |= ~(uint64_t)0 << d->count_w;
-    }
-    return (int64_t)count;   /* two's complement on every C99 target with int64_t */
 }
 
 int enc_qei_drv_read_position(const enc_qei_dev_t *d, unsigned k, int64_t *pos)

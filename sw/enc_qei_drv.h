@@ -59,7 +59,8 @@ extern "C" {
 #define ENC_QEI_DRV_OK        0
 #define ENC_QEI_DRV_ENODEV   (-1)  /* ID.MAGIC is not 0x5145: no enc_qei at this address */
 #define ENC_QEI_DRV_EVERSION (-2)  /* register map not 1.x with x >= 2 */
-#define ENC_QEI_DRV_ECAPS    (-3)  /* CAPS.CHANNELS is 0 or above 16 */
+#define ENC_QEI_DRV_ECAPS    (-3)  /* CAPS.CHANNELS 0 or above 16, COUNT_W 0 or above 64, or
+                                      TS_W above 32 */
 #define ENC_QEI_DRV_EINVAL   (-4)  /* a channel number >= CAPS.CHANNELS */
 #define ENC_QEI_DRV_ENOTSUP  (-5)  /* the build has no timing unit (CAPS.TIMING = 0) */
 #define ENC_QEI_DRV_ETIMEDOUT (-6) /* SNAP_READY did not come within dev.spin reads */
@@ -79,6 +80,7 @@ typedef struct {
     unsigned channels;      /* CAPS.CHANNELS, 1 .. 16 */
     unsigned profile;       /* CAPS.PROFILE: ENC_QEI__CAPS__PROFILE__*_VAL */
     unsigned count_w;       /* CAPS.COUNT_W */
+    uint64_t count_mask;    /* 2^COUNT_W - 1 */
     unsigned ts_w;          /* CAPS.TS_W */
     unsigned efifo_log2;    /* CAPS.EFIFO_LOG2: 0 = no edge FIFO */
     int      has_timing;    /* CAPS.TIMING: snapshots and the global snapshot */
@@ -97,7 +99,13 @@ const char *enc_qei_drv_strerror(int err);
 
 /* A COUNT_W-bit count (COUNT, SNAP_COUNT, a latch) as a signed position: two's complement in
  * COUNT_W bits. */
-int64_t enc_qei_drv_signed(const enc_qei_dev_t *d, uint64_t count);
+static inline int64_t enc_qei_drv_signed(const enc_qei_dev_t *d, uint64_t count)
+{
+    count &= d->count_mask;
+    if (count > d->count_mask >> 1)          /* bit COUNT_W - 1 set */
+        count |= ~d->count_mask;
+    return (int64_t)count;   /* two's complement on every C99 target with int64_t */
+}
 /* Channel k's count as a signed position (two's complement in COUNT_W bits): COUNT_LO, which
  * latches the high word, then COUNT_HI when COUNT_W > 32. On a shared-engine build a count
  * step shows up to the bound late; a snapshot is exact. */

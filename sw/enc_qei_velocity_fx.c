@@ -5,31 +5,19 @@
 
 #include <string.h>
 
-static uint32_t ts_mask(unsigned ts_w)
-{
-    return ts_w >= 32u ? 0xFFFFFFFFu : (uint32_t)((1ul << ts_w) - 1ul);
-}
-
 /* a - b modulo 2^TS_W */
-static uint32_t ts_diff(const qei_velfx_cfg_t *c, uint32_t a, uint32_t b)
+static uint32_t ts_diff(const qei_velfx_t *st, uint32_t a, uint32_t b)
 {
-    return (uint32_t)(a - b) & ts_mask(c->ts_w);
+    return (uint32_t)(a - b) & st->ts_mask;
 }
 
 /* count - prev modulo 2^COUNT_W, as a signed number */
-static int64_t count_diff(const qei_velfx_cfg_t *c, uint64_t count, uint64_t prev)
+static int64_t count_diff(const qei_velfx_t *st, uint64_t count, uint64_t prev)
 {
-    uint64_t mask = c->count_w >= 64u ? ~(uint64_t)0 : (((uint64_t)1 << c->count_w) - 1u);
-    uint64_t d = (count - prev) & mask;
-    uint64_t half = (uint64_t)1 << (c->count_w - 1u);
-    if (d >= half)
-        return -(int64_t)(mask - d) - 1;
+    uint64_t d = (count - prev) & st->count_mask;
+    if (d > (st->count_mask >> 1))
+        return -(int64_t)(st->count_mask - d) - 1;
     return (int64_t)d;
-}
-
-static int sign_of(int64_t x)
-{
-    return (x > 0) - (x < 0);
 }
 
 /* Leading zeros of a non-zero word. */
@@ -45,89 +33,64 @@ static unsigned nlz(uint32_t x)
 }
 
 /* (u1:u0) / v for u1 < v (the quotient fits 32 bits): Knuth's algorithm D with 16-bit digits,
- * two 32-bit divisions (Hacker's Delight, divlu). */
-static uint32_t divlu(uint32_t u1, uint32_t u0, uint32_t v)
+ * two 32-bit divisions (Hacker's Delight, divlu). Each estimated digit is a little too large at
+ * most (v normalised) and is corrected by comparing products, not with a remainder: a CPU like
+ * VexRiscv takes as long for a remu as for a divu. */
+static inline uint32_t divlu(uint32_t u1, uint32_t u0, uint32_t v)
 {
-    const uint32_t b = 0x10000u;
-    uint32_t vn1, vn0, un32, un21, un10, un1, un0, q1, q0, rhat;
+    uint32_t vn1, un32, un21, un10, q1, q0;
     unsigned s = nlz(v);
 
     v <<= s;
     vn1 = v >> 16;
-    vn0 = v & 0xFFFFu;
     un32 = s ? (u1 << s) | (u0 >> (32u - s)) : u1;
     un10 = u0 << s;
-    un1 = un10 >> 16;
-    un0 = un10 & 0xFFFFu;
-    q1 = un32 / vn1;
-    rhat = un32 - q1 * vn1;
-    while (q1 >= b || q1 * vn0 > ((rhat << 16) | un1)) {
+    q1 = un32 / vn1;          /* at most 4 too large (un32 < v; Knuth 4.3.1, theorem B) */
+    while ((uint64_t)q1 * v > (((uint64_t)un32 << 16) | (un10 >> 16)))
         q1--;
-        rhat += vn1;
-        if (rhat >= b)
-            break;
-    }
-    un21 = (un32 << 16) + un1 - q1 * v;       /* modulo 2^32: the true value fits */
+    un21 = (un32 << 16) + (un10 >> 16) - q1 * v;   /* modulo 2^32: the true value is < v */
     q0 = un21 / vn1;
-    rhat = un21 - q0 * vn1;
-    while (q0 >= b || q0 * vn0 > ((rhat << 16) | un0)) {
+    while ((uint64_t)q0 * v > (((uint64_t)un21 << 16) | (un10 & 0xFFFFu)))
         q0--;
-        rhat += vn1;
-        if (rhat >= b)
-            break;
-    }
     return (q1 << 16) | q0;
 }
 
-/* num * 2^F / den rounded to the nearest (ties up), saturated at QEI_VELFX_MAX; den > 0, and
- * num_ovf says that num itself did not fit 64 bits. */
-static uint32_t ratio(uint64_t num, int num_ovf, unsigned f, uint32_t den)
+/* x << f for f < 32, in 32-bit shifts (no library call on a 32-bit CPU) */
+static uint64_t shl(uint64_t x, unsigned f)
+{
+    uint32_t hi = (uint32_t)(x >> 32), lo = (uint32_t)x;
+    if (f == 0u)
+        return x;
+    hi = (hi << f) | (lo >> (32u - f));
+    return ((uint64_t)hi << 32) | (uint32_t)(lo << f);
+}
+
+/* num * 2^F / den rounded to the nearest (ties up), saturated at QEI_VELFX_MAX; den > 0 */
+static inline uint32_t ratio(const qei_velfx_t *st, uint64_t num, uint32_t den)
 {
     uint64_t n;
-    if (num == 0u && !num_ovf)
-        return 0u;
-    /* num * 2^F >= 2^64 means a quotient >= 2^32 (den < 2^32): saturated */
-    if (num_ovf || (f && (num >> (64u - f)) != 0u))
+    uint32_t q;
+    if (num > st->num_max)                  /* num * 2^F >= 2^63: a quotient >= 2^31 */
         return QEI_VELFX_MAX;
-    n = num << f;
-    if (n > ~(uint64_t)0 - (den >> 1))
+    n = shl(num, st->cfg.frac_bits) + (den >> 1);     /* < 2^63 + 2^31: no overflow */
+    if ((uint32_t)(n >> 32) >= den)         /* quotient >= 2^32 */
         return QEI_VELFX_MAX;
-    n += den >> 1;
-    if ((uint32_t)(n >> 32) >= den)           /* quotient >= 2^32 */
-        return QEI_VELFX_MAX;
-    n = divlu((uint32_t)(n >> 32), (uint32_t)n, den);
-    return n > QEI_VELFX_MAX ? QEI_VELFX_MAX : (uint32_t)n;
+    q = divlu((uint32_t)(n >> 32), (uint32_t)n, den);
+    return q > QEI_VELFX_MAX ? QEI_VELFX_MAX : q;
 }
 
-/* a * b, and whether it overflowed 64 bits */
-static uint64_t mul64(uint64_t a, uint32_t b, int *ovf)
+/* x * tick_hz * 2^F / den for a magnitude x */
+static inline uint32_t rate(const qei_velfx_t *st, uint64_t x, uint32_t den)
 {
-    uint64_t lo = (a & 0xFFFFFFFFu) * b, hi = (a >> 32) * b;
-    *ovf = (hi >> 32) != 0u || lo > ~(uint64_t)0 - (hi << 32);
-    return lo + (hi << 32);
-}
-
-/* |x| * tick_hz * 2^F / den, signed like x */
-static int32_t rate(const qei_velfx_cfg_t *c, int64_t x, uint32_t den)
-{
-    int ovf;
-    uint64_t a = x < 0 ? (uint64_t)0 - (uint64_t)x : (uint64_t)x;
-    uint64_t num = mul64(a, c->tick_hz, &ovf);
-    int32_t mag = (int32_t)ratio(num, ovf, c->frac_bits, den);
-    return x < 0 ? -mag : mag;
-}
-
-static uint32_t bounded(const qei_velfx_t *st, uint32_t mag, int new_edge, uint32_t since,
-                        int stalled)
-{
-    if (stalled)
-        return 0u;
-    if (!new_edge && since > 0u && mag > 0u) {
-        uint32_t bound = ratio(st->edge_num, 0, st->cfg.frac_bits, since);
-        if (bound < mag)
-            return bound;
-    }
-    return mag;
+    uint64_t num, hi;
+    if (x <= 0xFFFFFFFFu)                   /* the usual case: the product fits 64 bits */
+        return x ? ratio(st, x * st->cfg.tick_hz, den) : 0u;
+    hi = (x >> 32) * st->cfg.tick_hz;       /* a 64-bit count difference */
+    if (hi >= (uint64_t)1 << 31)
+        return QEI_VELFX_MAX;               /* x * tick_hz >= 2^63 */
+    /* < 2^63 + 2^63: hi < 2^31 with x >= 2^32 means tick_hz < 2^31 */
+    num = (hi << 32) + (x & 0xFFFFFFFFu) * st->cfg.tick_hz;
+    return ratio(st, num, den);
 }
 
 int qei_velfx_init(qei_velfx_t *st, const qei_velfx_cfg_t *cfg)
@@ -138,43 +101,45 @@ int qei_velfx_init(qei_velfx_t *st, const qei_velfx_cfg_t *cfg)
         return -1;
     st->cfg = *cfg;
     st->edge_num = (uint64_t)cfg->counts_per_edge * cfg->tick_hz;
+    st->num_max = (~(uint64_t)0 >> 1) >> cfg->frac_bits;
+    st->ts_mask = cfg->ts_w >= 32u ? 0xFFFFFFFFu : (uint32_t)(((uint32_t)1 << cfg->ts_w) - 1u);
+    st->count_mask = cfg->count_w >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << cfg->count_w) - 1u;
     st->mt_ref = 1;
     return 0;
 }
 
-qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *s)
+/* The first snapshot only initialises: keeps its times and count, returns 1 then. cdir: the
+ * direction of its counts (SNAP_DELTA, or the count difference), |delta| into *dmag. */
+static inline int take(qei_velfx_t *st, const qei_vel_snap_t *s, int *cdir, uint64_t *dmag)
 {
-    const qei_velfx_cfg_t *c = &st->cfg;
-    qei_velfx_reading_t r = {0, 0, 0};
-    uint32_t prev_time = st->prev_time, prev_edge_time = st->prev_edge_time;
-    uint64_t prev_count = st->prev_count;
-    uint32_t dt, since, t_mag;
-    int64_t delta;
-    int stalled, new_edge, cdir;
-
+    if (st->cfg.delta_from_count) {
+        int64_t delta = count_diff(st, s->count, st->prev_count);
+        *cdir = (delta > 0) - (delta < 0);
+        *dmag = delta < 0 ? (uint64_t)0 - (uint64_t)delta : (uint64_t)delta;
+    } else {
+        *cdir = (s->delta > 0) - (s->delta < 0);
+        *dmag = s->delta < 0 ? (uint32_t)0 - (uint32_t)s->delta : (uint32_t)s->delta;
+    }
     st->prev_time = s->time;
     st->prev_edge_time = s->edge_time;
     st->prev_count = s->count;
-    if (!st->have_prev) {
-        st->have_prev = 1;
-        return r;
-    }
-    /* M: unit time */
-    dt = ts_diff(c, s->time, prev_time);
-    delta = c->delta_from_count ? count_diff(c, s->count, prev_count) : (int64_t)s->delta;
-    r.m = dt > 0u ? rate(c, delta, dt) : 0;
-    since = ts_diff(c, s->time, s->edge_time);
-    stalled = s->stalled || (c->stall_ticks > 0u && since >= c->stall_ticks);
-    new_edge = s->edge_delta != 0 || s->edge_time != prev_edge_time;
-    cdir = sign_of(delta);
-    /* M/T: timestamp */
+    if (st->have_prev)
+        return 0;
+    st->have_prev = 1;
+    return 1;
+}
+
+/* M/T: the direction and magnitude of the last measurement after this snapshot (its rules) */
+static inline void mt_step(qei_velfx_t *st, const qei_vel_snap_t *s, int cdir, int new_edge,
+                    uint32_t prev_edge_time)
+{
     if (cdir != 0 && st->mt_dir != 0 && cdir != st->mt_dir) {
         st->mt_dir = cdir; /* the counts reversed: 0 until re-referenced */
         st->mt_mag = 0u;
         st->mt_ref = 1;
     }
     if (new_edge) {
-        int d = sign_of(s->edge_delta);
+        int d = (s->edge_delta > 0) - (s->edge_delta < 0);
         if (st->mt_ref || d == 0 || (st->mt_dir != 0 && d != st->mt_dir)) {
             if (d != 0 && !st->mt_ref)
                 st->mt_dir = d; /* reversal rule: reads 0, new reference */
@@ -183,14 +148,40 @@ qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *s)
             st->mt_mag = 0u;
             st->mt_ref = 0;
         } else {
-            uint32_t dte = ts_diff(c, s->edge_time, prev_edge_time);
+            uint32_t dte = ts_diff(st, s->edge_time, prev_edge_time);
             if (dte > 0u)
-                st->mt_mag = (uint32_t)rate(c, s->edge_delta < 0 ? -(int64_t)s->edge_delta
-                                                                  : (int64_t)s->edge_delta, dte);
+                st->mt_mag = rate(st, s->edge_delta < 0 ? (uint32_t)0 - (uint32_t)s->edge_delta
+                                                        : (uint32_t)s->edge_delta, dte);
             st->mt_dir = d;
         }
     }
-    r.mt = st->mt_dir * (int32_t)bounded(st, st->mt_mag, new_edge, since, stalled);
+}
+
+static int32_t with_dir(int dir, uint32_t mag)
+{
+    return dir < 0 ? -(int32_t)mag : dir > 0 ? (int32_t)mag : 0;
+}
+
+qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *s)
+{
+    const qei_velfx_cfg_t *c = &st->cfg;
+    qei_velfx_reading_t r = {0, 0, 0};
+    uint32_t prev_time = st->prev_time, prev_edge_time = st->prev_edge_time;
+    uint32_t dt, since, t_mag = 0u, mt_mag, bound = 0u;
+    uint64_t dmag;
+    int stalled, new_edge, cdir;
+
+    if (take(st, s, &cdir, &dmag))
+        return r;
+    /* M: unit time */
+    dt = ts_diff(st, s->time, prev_time);
+    if (dt > 0u)
+        r.m = with_dir(cdir, rate(st, dmag, dt));
+    since = ts_diff(st, s->time, s->edge_time);
+    stalled = s->stalled || (c->stall_ticks > 0u && since >= c->stall_ticks);
+    new_edge = s->edge_delta != 0 || s->edge_time != prev_edge_time;
+    /* M/T: timestamp */
+    mt_step(st, s, cdir, new_edge, prev_edge_time);
     /* T: period */
     if (cdir != 0 && st->t_dir != 0 && cdir != st->t_dir)
         st->t_hold = 1;
@@ -198,11 +189,40 @@ qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *s)
         st->t_hold = 0;
     if (cdir != 0)
         st->t_dir = cdir;
-    if (st->t_hold || s->period == 0u || s->period_ovf || s->period_dir_change)
-        t_mag = 0u;
-    else
-        t_mag = (uint32_t)rate(c, (int64_t)(s->period_n > 1u ? s->period_n : 1u) *
-                                      (int64_t)c->counts_per_edge, s->period);
-    r.t = st->t_dir * (int32_t)bounded(st, t_mag, new_edge, since, stalled);
+    if (!(st->t_hold || s->period == 0u || s->period_ovf || s->period_dir_change))
+        t_mag = rate(st, (uint64_t)(s->period_n > 1u ? s->period_n : 1u) * c->counts_per_edge,
+                     s->period);
+    if (stalled)
+        return r;                      /* MT and T read 0; mt_mag is kept */
+    /* the standstill rule: at most one edge's counts over the time since the last edge */
+    mt_mag = st->mt_mag;
+    if (!new_edge && since > 0u && (mt_mag > 0u || t_mag > 0u)) {
+        bound = ratio(st, st->edge_num, since);
+        mt_mag = bound < mt_mag ? bound : mt_mag;
+        t_mag = bound < t_mag ? bound : t_mag;
+    }
+    r.mt = with_dir(st->mt_dir, mt_mag);
+    r.t = with_dir(st->t_dir, t_mag);
     return r;
+}
+
+int32_t qei_velfx_update_mt(qei_velfx_t *st, const qei_vel_snap_t *s)
+{
+    uint32_t prev_edge_time = st->prev_edge_time, since, mag;
+    uint64_t dmag;
+    int new_edge, cdir;
+
+    if (take(st, s, &cdir, &dmag))
+        return 0;
+    since = ts_diff(st, s->time, s->edge_time);
+    new_edge = s->edge_delta != 0 || s->edge_time != prev_edge_time;
+    mt_step(st, s, cdir, new_edge, prev_edge_time);
+    if (s->stalled || (st->cfg.stall_ticks > 0u && since >= st->cfg.stall_ticks))
+        return 0;
+    mag = st->mt_mag;
+    if (!new_edge && since > 0u && mag > 0u) {
+        uint32_t bound = ratio(st, st->edge_num, since);
+        mag = bound < mag ? bound : mag;
+    }
+    return with_dir(st->mt_dir, mag);
 }

@@ -61,6 +61,9 @@ typedef struct {
 typedef struct {
     qei_velfx_cfg_t cfg;
     uint64_t edge_num;   /* counts_per_edge * tick_hz: the standstill bound's numerator */
+    uint64_t num_max;    /* the largest numerator whose 2^F multiple fits 64 bits */
+    uint64_t count_mask; /* 2^COUNT_W - 1 */
+    uint32_t ts_mask;    /* 2^TS_W - 1 */
     uint64_t prev_count;
     uint32_t prev_time, prev_edge_time;
     int      have_prev;
@@ -75,6 +78,10 @@ typedef struct {
 int qei_velfx_init(qei_velfx_t *st, const qei_velfx_cfg_t *cfg);
 /* One snapshot in, three readings (2^-F count steps per second) out. */
 qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *snap);
+/* The timestamp method alone: qei_velfx_update(st, snap).mt without computing M and T, for a
+ * servo loop that reads only MT (about half the cycles). Feed a state with one of the two
+ * functions, not both: this one leaves T's state alone. */
+int32_t qei_velfx_update_mt(qei_velfx_t *st, const qei_vel_snap_t *snap);
 
 #ifdef __cplusplus
 }

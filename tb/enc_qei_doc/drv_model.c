@@ -342,6 +342,10 @@ static int test_init(void)
         {0x51450202u, ENC_QEI__CAPS__CHANNELS_SET(4u), ENC_QEI_DRV_EVERSION},
         {0x51450102u, ENC_QEI__CAPS__CHANNELS_SET(0u), ENC_QEI_DRV_ECAPS},
         {0x51450102u, ENC_QEI__CAPS__CHANNELS_SET(17u), ENC_QEI_DRV_ECAPS},
+        {0x51450102u, ENC_QEI__CAPS__CHANNELS_SET(2u) | ENC_QEI__CAPS__COUNT_W_SET(65u),
+         ENC_QEI_DRV_ECAPS},
+        {0x51450102u, ENC_QEI__CAPS__CHANNELS_SET(2u) | ENC_QEI__CAPS__TS_W_SET(33u),
+         ENC_QEI_DRV_ECAPS},
     };
     unsigned i;
     for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
@@ -349,7 +353,8 @@ static int test_init(void)
         int got;
         reset_model(16u, 32u, 32u, 1u, 1u, 0u, 0u);
         m.id = cases[i].id;
-        m.caps = cases[i].caps | ENC_QEI__CAPS__COUNT_W_SET(32u);
+        m.caps = cases[i].caps | (ENC_QEI__CAPS__COUNT_W_GET(cases[i].caps) ? 0u
+                                  : ENC_QEI__CAPS__COUNT_W_SET(32u));
         m.channels = ENC_QEI__CAPS__CHANNELS_GET(m.caps) ? ENC_QEI__CAPS__CHANNELS_GET(m.caps) : 1u;
         if (m.channels > NCH)
             m.channels = NCH;

@@ -6,7 +6,8 @@ Both run on the same snapshots in one process (velfx_driver.c). Every fixed-poin
 units of 2^-F count steps per second, must be within one unit of the double reading * 2^F
 (clipped to the stated range, +-(2^31 - 1) units: beyond it the fixed point saturates), and
 exactly 0 wherever the double reading is exactly 0 (the rules, not the arithmetic, make those).
-The header promises half a unit; the tests print the largest error seen. Inputs: modelled
+The header promises half a unit; the tests print the largest error seen. qei_velfx_update_mt()
+(the timestamp method alone) must read exactly what qei_velfx_update() reads for MT, everywhere. Inputs: modelled
 HEDS-5000 snapshot streams (as the agreement test of the double version), random streams with
 timebase and count wraps at several widths, standstill, reversals, jumps, period flags and stall,
 and hand-made edge cases (saturation, rounding ties, extreme tick rates and F). Every hand-made
@@ -38,7 +39,8 @@ def tick_hz_of(cfg: EstimatorConfig) -> int:
 
 
 def run_fx(exe: Path, cfg: EstimatorConfig, frac: int, snaps, tick_hz: int | None = None):
-    """(double readings (n, 3), fixed readings (n, 3)) of M, T, MT per snapshot."""
+    """(double readings (n, 3), fixed readings (n, 3)) of M, T, MT per snapshot; asserts that
+    qei_velfx_update_mt() reads exactly qei_velfx_update()'s MT."""
     hz = tick_hz_of(cfg) if tick_hz is None else tick_hz
     lines = [f"{hz} {frac} {cfg.ts_w} {cfg.count_w} {cfg.counts_per_edge} "
              f"{int(cfg.stall_ticks)} {int(cfg.delta_from_count)}"]
@@ -46,12 +48,16 @@ def run_fx(exe: Path, cfg: EstimatorConfig, frac: int, snaps, tick_hz: int | Non
         lines.append(f"{s.count} {s.time} {s.edge_time} {s.delta} {s.edge_delta} {s.period} "
                      f"{s.period_n} {s.period_ovf} {s.period_dir_change} {s.stalled}")
     res = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True,
-                         text=True)
+                         text=True, timeout=60)
     assert res.returncode == 0, res.stderr
     rows = [ln.split() for ln in res.stdout.splitlines()]
     assert len(rows) == len(snaps), f"{len(rows)} readings for {len(snaps)} snapshots"
     dbl = np.array([[float(x) for x in r[:3]] for r in rows]).reshape(-1, 3)
-    fx = np.array([[int(x) for x in r[3:]] for r in rows], dtype=np.int64).reshape(-1, 3)
+    fx = np.array([[int(x) for x in r[3:6]] for r in rows], dtype=np.int64).reshape(-1, 3)
+    mt_only = np.array([int(r[6]) for r in rows], dtype=np.int64)
+    bad = np.flatnonzero(mt_only != fx[:, 2])
+    assert not bad.size, (f"qei_velfx_update_mt() read {mt_only[bad[0]]}, qei_velfx_update() MT "
+                          f"{fx[bad[0], 2]} at snapshot {bad[0]} (F = {frac}; {cfg})")
     return dbl, fx
 
 
@@ -265,7 +271,8 @@ def test_fixed_rejects_bad_config(c_fixed):
     for line in ("0 8 32 32 1 0 0", "1000 32 32 32 1 0 0", "1000 8 0 32 1 0 0",
                  "1000 8 33 32 1 0 0", "1000 8 32 0 1 0 0", "1000 8 32 65 1 0 0",
                  "1000 8 32 32 0 0 0"):
-        res = subprocess.run([str(c_fixed)], input=line + "\n", capture_output=True, text=True)
+        res = subprocess.run([str(c_fixed)], input=line + "\n", capture_output=True, text=True,
+                             timeout=60)
         assert res.returncode == 2 and "fixed-point configuration out of range" in res.stderr, line
 
 
@@ -288,3 +295,76 @@ def test_no_floating_point(tmp_path):
 
     assert compiles("enc_qei_velocity_fx.c")
     assert not compiles("enc_qei_velocity.c"), "the check cannot tell floating point apart"
+
+
+# ----------------------------------------------------------------------------- the arithmetic
+
+def run_units(exe: Path, cases: list[str]) -> list[int]:
+    res = subprocess.run([str(exe), "units"], input="\n".join(cases) + "\n", capture_output=True,
+                         text=True, timeout=60)
+    assert res.returncode == 0, res.stderr
+    out = [int(x) for x in res.stdout.split()]
+    assert len(out) == len(cases)
+    return out
+
+
+def test_division_and_rounding_exactly(c_fixed):
+    """The estimator's arithmetic on its own, against Python's integers: the 64-by-32-bit division
+    (every divisor width, exact multiples, remainders of v - 1, quotients up to 2^32 - 1), the
+    rounded and saturated num * 2^F / den at every F (also numerators just below and above the
+    2^63 saturation limit), and x * tick_hz * 2^F / den with 64-bit x (a 64-bit count
+    difference)."""
+    seed = int(np.random.default_rng().integers(1 << 30))
+    print(f"seed {seed}")
+    rng = np.random.default_rng(seed)
+    u64 = lambda: int.from_bytes(rng.bytes(8), "little")   # noqa: E731
+    div, want = [], []
+    for _ in range(3000):
+        v = max(1, u64() >> int(rng.integers(32, 64)))
+        q = u64() >> 32
+        r = int(rng.choice([0, v - 1, u64() % v]))
+        n = q * v + r
+        if n >> 64 or (n >> 32) >= v:
+            continue
+        div.append(f"div {n >> 32} {n & 0xFFFFFFFF} {v}")
+        want.append(n // v)
+    assert run_units(c_fixed, div) == want, "divlu differs from the exact quotient"
+
+    def rounded(num: int, f: int, den: int) -> int:
+        return min((num * 2**f + den // 2) // den, FX_MAX)
+
+    ratio, want = [], []
+    for _ in range(3000):
+        f = int(rng.integers(0, 32))
+        den = max(1, u64() >> int(rng.integers(32, 64)))
+        kind = rng.integers(0, 4)
+        if kind == 0:       # around the saturation limit 2^63 of num * 2^F
+            num = ((2**63 - 1) >> f) + int(rng.integers(-3, 4))
+        elif kind == 3:     # num * 2^F + den / 2 just below 2^64
+            num = ((2**64 - 1) >> f) - int(rng.integers(0, 4))
+            den = max(den, 2**31 + int(rng.integers(0, 2**31)))
+        elif kind == 1:     # a quotient near the range limit
+            num = max(0, (FX_MAX * den) >> f) + int(rng.integers(-3, 4))
+        else:
+            num = u64() >> int(rng.integers(0, 64))
+        num = max(0, min(num, 2**64 - 1))
+        ratio.append(f"ratio {f} {num} {den}")
+        want.append(rounded(num, f, den))
+    got = run_units(c_fixed, ratio)
+    bad = [(c, g, w) for c, g, w in zip(ratio, got, want) if g != w]
+    assert not bad, f"{len(bad)} ratios differ, first {bad[0]}"
+
+    rate, want = [], []
+    for _ in range(2000):
+        f = int(rng.integers(0, 32))
+        tick = int(rng.choice([1, 1000, 50_000_000, 2**32 - 1]))
+        x = u64() >> int(rng.integers(0, 64))
+        if rng.random() < 0.3:  # x above 32 bits, x * tick_hz near the limits 2^63, 2^64
+            x = 2**32 + (u64() >> int(rng.integers(28, 40)))
+            tick = int(rng.choice([2**32 - 1, 2**31 - 1, 2**31 + 1, 2**30 + 7]))
+        den = max(1, u64() >> int(rng.integers(32, 64)))
+        rate.append(f"rate {f} {tick} {x} {den}")
+        want.append(rounded(x * tick, f, den) if x else 0)
+    got = run_units(c_fixed, rate)
+    bad = [(c, g, w) for c, g, w in zip(rate, got, want) if g != w]
+    assert not bad, f"{len(bad)} rates differ, first {bad[0]}"
