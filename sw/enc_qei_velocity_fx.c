@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* enc_qei_velocity_fx.c -- see enc_qei_velocity_fx.h. qei_vel_update() (enc_qei_velocity.c) in
- * integers: the same decisions in the same order, each double division replaced by ratio(). */
+ * integers: the same decisions, each double division replaced by rate() or ratio(). The helpers
+ * of the interrupt path are inline: on a soft CPU a call costs as much as a few lines of it. */
 #include "enc_qei_velocity_fx.h"
 
 #include <string.h>
@@ -33,8 +34,8 @@ static unsigned nlz(uint32_t x)
 }
 
 /* (u1:u0) / v for u1 < v (the quotient fits 32 bits): Knuth's algorithm D with 16-bit digits,
- * two 32-bit divisions (Hacker's Delight, divlu). Each estimated digit is a little too large at
- * most (v normalised) and is corrected by comparing products, not with a remainder: a CPU like
+ * two 32-bit divisions (Hacker's Delight, divlu). An estimated digit is at most 4 too large (v
+ * normalised) and is corrected by comparing products, not through a remainder: a CPU like
  * VexRiscv takes as long for a remu as for a divu. */
 static inline uint32_t divlu(uint32_t u1, uint32_t u0, uint32_t v)
 {
@@ -45,7 +46,7 @@ static inline uint32_t divlu(uint32_t u1, uint32_t u0, uint32_t v)
     vn1 = v >> 16;
     un32 = s ? (u1 << s) | (u0 >> (32u - s)) : u1;
     un10 = u0 << s;
-    q1 = un32 / vn1;          /* at most 4 too large (un32 < v; Knuth 4.3.1, theorem B) */
+    q1 = un32 / vn1;                          /* Knuth 4.3.1, theorem B, with un32 < v */
     while ((uint64_t)q1 * v > (((uint64_t)un32 << 16) | (un10 >> 16)))
         q1--;
     un21 = (un32 << 16) + (un10 >> 16) - q1 * v;   /* modulo 2^32: the true value is < v */
@@ -88,7 +89,7 @@ static inline uint32_t rate(const qei_velfx_t *st, uint64_t x, uint32_t den)
     hi = (x >> 32) * st->cfg.tick_hz;       /* a 64-bit count difference */
     if (hi >= (uint64_t)1 << 31)
         return QEI_VELFX_MAX;               /* x * tick_hz >= 2^63 */
-    /* < 2^63 + 2^63: hi < 2^31 with x >= 2^32 means tick_hz < 2^31 */
+    /* no overflow: hi < 2^31 with x >= 2^32 means tick_hz < 2^31, so both terms are < 2^63 */
     num = (hi << 32) + (x & 0xFFFFFFFFu) * st->cfg.tick_hz;
     return ratio(st, num, den);
 }
@@ -131,7 +132,7 @@ static inline int take(qei_velfx_t *st, const qei_vel_snap_t *s, int *cdir, uint
 
 /* M/T: the direction and magnitude of the last measurement after this snapshot (its rules) */
 static inline void mt_step(qei_velfx_t *st, const qei_vel_snap_t *s, int cdir, int new_edge,
-                    uint32_t prev_edge_time)
+                           uint32_t prev_edge_time)
 {
     if (cdir != 0 && st->mt_dir != 0 && cdir != st->mt_dir) {
         st->mt_dir = cdir; /* the counts reversed: 0 until re-referenced */

@@ -15,7 +15,7 @@
  *   range       +-(2^31 - 1) * 2^-F  (F = 8: +-8,388,607.996 count/s; F = 16: +-32,767.99998)
  * A reading is the exact quotient of the double version (count steps * tick_hz * 2^F over the
  * ticks) rounded to the nearest unit, ties away from zero, so it differs from the double
- * version's reading * 2^F by at most 1/2 unit (plus the double's own rounding, below 1e-6
+ * version's reading * 2^F by at most 1/2 unit (plus the double's own rounding, below 1e-5
  * unit); tb/velocity/test_velocity_fixed.py fails when any reading is off by more than one unit.
  * A speed beyond the range reads +-(2^31 - 1) (QEI_VELFX_MAX): saturated, never wrapped. Pick F
  * for the fastest speed the axis can reach: count steps per second < 2^(31 - F).
@@ -24,10 +24,11 @@
  * integer number of Hz (50 MHz with TB_PRESCALE 0, 4, 9, ...; the double version takes any
  * tick). Intervals are taken modulo 2^TS_W as in the double version.
  *
- * Cost: at most three 64-by-32-bit divisions per update (M when SNAP_DELTA != 0, MT on a new
- * edge or its standstill bound, T with a period), each one by two 32-bit hardware divisions
- * (RV32M's divu); none where a reading is 0 by rule. The first snapshot after qei_velfx_init
- * only initialises (all readings 0).
+ * Cost: at most three 64-by-32-bit divisions per qei_velfx_update() (M when the counts moved,
+ * MT on a new edge or else the standstill bound, T with a period), at most one per
+ * qei_velfx_update_mt(), each by two 32-bit hardware divisions (RV32M's divu); none where a
+ * reading is 0 by rule. The first snapshot after qei_velfx_init only initialises (all readings
+ * 0).
  */
 #ifndef ENC_QEI_VELOCITY_FX_H
 #define ENC_QEI_VELOCITY_FX_H
@@ -78,8 +79,8 @@ typedef struct {
 int qei_velfx_init(qei_velfx_t *st, const qei_velfx_cfg_t *cfg);
 /* One snapshot in, three readings (2^-F count steps per second) out. */
 qei_velfx_reading_t qei_velfx_update(qei_velfx_t *st, const qei_vel_snap_t *snap);
-/* The timestamp method alone: qei_velfx_update(st, snap).mt without computing M and T, for a
- * servo loop that reads only MT (about half the cycles). Feed a state with one of the two
+/* The timestamp method alone: qei_velfx_update(st, snap).mt without computing M and T (none of
+ * their divisions), for a servo loop that reads only MT. Feed a state with one of the two
  * functions, not both: this one leaves T's state alone. */
 int32_t qei_velfx_update_mt(qei_velfx_t *st, const qei_vel_snap_t *snap);
 
