@@ -41,8 +41,8 @@ int enc_qei_drv_init(enc_qei_dev_t *d, volatile enc_qei_t *regs)
     d->efifo_log2 = ENC_QEI__CAPS__EFIFO_LOG2_GET(caps);
     d->has_timing = (int)ENC_QEI__CAPS__TIMING_GET(caps);
     d->spin = ENC_QEI_DRV_SPIN_DEFAULT;
-    d->gsnap_ctrl = d->has_timing ? RD(regs->glb.GSNAP_CTRL) & ~(uint32_t)ENC_QEI__GSNAP_CTRL__CMD_bm
-                                  : 0u;
+    d->gsnap_ctrl = d->has_timing
+        ? RD(regs->glb.GSNAP_CTRL) & ~(uint32_t)ENC_QEI__GSNAP_CTRL__CMD_bm : 0u;
     for (k = 0; k < ENC_QEI_CHANNELS_MAX; k++) {
         int here = k < d->channels;
         d->snap_ctrl[k] = here && d->has_timing

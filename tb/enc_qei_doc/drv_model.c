@@ -75,14 +75,26 @@ static unsigned checks, failures;
 
 /* ---- the motion --------------------------------------------------------------------------- */
 
-static uint64_t cmask(void) { return m.count_w >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << m.count_w) - 1u; }
-static uint32_t tmask(void) { return m.ts_w >= 32u ? 0xFFFFFFFFu : (uint32_t)((1ul << m.ts_w) - 1ul); }
+static uint64_t cmask(void)
+{
+    return m.count_w >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << m.count_w) - 1u;
+}
+
+static uint32_t tmask(void)
+{
+    return m.ts_w >= 32u ? 0xFFFFFFFFu : (uint32_t)((1ul << m.ts_w) - 1ul);
+}
+
 static int64_t speed(unsigned k) { return (int64_t)k * 3 - 7; }   /* count steps per tick */
 static uint64_t start(unsigned k) { return cmask() - 40u * k - 500u; } /* near the wrap */
 #define EDGE_EVERY(k) (5u + (k))
 
 /* the count at tick t (exact, then wrapped to COUNT_W bits) */
-static uint64_t count_at(unsigned k, uint64_t t) { return (start(k) + (uint64_t)(speed(k) * (int64_t)t)) & cmask(); }
+static uint64_t count_at(unsigned k, uint64_t t)
+{
+    return (start(k) + (uint64_t)(speed(k) * (int64_t)t)) & cmask();
+}
+
 static uint64_t edge_at(unsigned k, uint64_t t) { return t / EDGE_EVERY(k) * EDGE_EVERY(k); }
 
 /* the snapshot registers of channel k for a snapshot at t, the previous one at prev */
@@ -92,7 +104,8 @@ static void expect(unsigned k, uint64_t t, uint64_t prev, int have_prev, qei_vel
     s->time = (uint32_t)t & tmask();
     s->edge_time = (uint32_t)edge_at(k, t) & tmask();
     s->delta = have_prev ? (int32_t)(speed(k) * (int64_t)(t - prev)) : 0;
-    s->edge_delta = have_prev ? (int32_t)(speed(k) * (int64_t)(edge_at(k, t) - edge_at(k, prev))) : 0;
+    s->edge_delta = have_prev
+        ? (int32_t)(speed(k) * (int64_t)(edge_at(k, t) - edge_at(k, prev))) : 0;
 }
 
 /* ---- the registers ------------------------------------------------------------------------ */
@@ -135,7 +148,8 @@ static void apply_write(uint32_t off, uint32_t v)
     unsigned page = off / ENC_QEI_PAGE, reg = off % ENC_QEI_PAGE;
     if (page == 0u && reg == ENC_QEI_GSNAP_CTRL_OFFSET) {
         if (!m.timing) return;
-        if ((v & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm) && !(m.gsnap_ctrl & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm))
+        if ((v & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm) &&
+            !(m.gsnap_ctrl & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm))
             m.timer_next = m.now + (m.gsnap_period ? m.gsnap_period : 1u);
         m.gsnap_ctrl = v & ~(uint32_t)ENC_QEI__GSNAP_CTRL__CMD_bm;
         if (v & ENC_QEI__GSNAP_CTRL__CMD_bm)
@@ -165,7 +179,8 @@ static void advance(void)
             m.wq[j++] = m.wq[i];
     }
     m.nwq = j;
-    while (m.timing && (m.gsnap_ctrl & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm) && m.now >= m.timer_next) {
+    while (m.timing && (m.gsnap_ctrl & ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm) &&
+           m.now >= m.timer_next) {
         snapshot(m.timer_next, 1, 0);
         m.timer_next += m.gsnap_period ? m.gsnap_period : 1u;
     }
@@ -246,7 +261,8 @@ static uint32_t model_rd(volatile uint32_t *reg)
         v = (uint32_t)c;
     } else if (reg_off == ENC_QEI_COUNT_HI_OFFSET) {
         v = m.count_hi_latch[page];
-    } else if (reg_off >= ENC_QEI_SNAP_COUNT_LO_OFFSET && reg_off <= ENC_QEI_SNAP_EDGE_DELTA_OFFSET) {
+    } else if (reg_off >= ENC_QEI_SNAP_COUNT_LO_OFFSET &&
+               reg_off <= ENC_QEI_SNAP_EDGE_DELTA_OFFSET) {
         v = m.timing ? snap_reg(page, reg_off) : 0u;
     } else if (reg_off == ENC_QEI_PERIOD_OFFSET) {
         v = m.full ? 1234u : 0u;
@@ -327,7 +343,7 @@ static void check_snap(const char *what, unsigned k, const qei_vel_snap_t *got, 
           want.edge_delta);
 }
 
-static int test_init(void)
+static void test_init(void)
 {
     struct { uint32_t id, caps; int want; } cases[] = {
         {0x51450102u, ENC_QEI__CAPS__CHANNELS_SET(4u), ENC_QEI_DRV_OK},
@@ -359,14 +375,14 @@ static int test_init(void)
         if (m.channels > NCH)
             m.channels = NCH;
         got = enc_qei_drv_init(&d, (volatile enc_qei_t *)&space);
-        CHECK(got == cases[i].want, "ID 0x%08" PRIx32 " CAPS 0x%08" PRIx32 ": init returned %d (%s), "
+        CHECK(got == cases[i].want,
+              "ID 0x%08" PRIx32 " CAPS 0x%08" PRIx32 ": init returned %d (%s), "
               "want %d", cases[i].id, cases[i].caps, got, enc_qei_drv_strerror(got), cases[i].want);
         CHECK(got != ENC_QEI_DRV_OK || d.channels == ENC_QEI__CAPS__CHANNELS_GET(cases[i].caps),
               "channels %u", d.channels);
         CHECK(got == ENC_QEI_DRV_OK || m.accesses == 2u, "a refused init made %u accesses, not "
               "2 (ID, CAPS)", m.accesses);
     }
-    return 0;
 }
 
 static void test_positions(enc_qei_dev_t *d)
@@ -383,7 +399,8 @@ static void test_positions(enc_qei_dev_t *d)
         CHECK(pos == want, "channel %u: position %" PRId64 ", the count at the read %" PRId64, k,
               pos, want);
     }
-    CHECK(enc_qei_drv_read_position(d, d->channels, NULL) == ENC_QEI_DRV_EINVAL, "channel >= CHANNELS");
+    CHECK(enc_qei_drv_read_position(d, d->channels, NULL) == ENC_QEI_DRV_EINVAL,
+          "channel >= CHANNELS");
 }
 
 static void check_all(const char *what, const qei_vel_snap_t *s, unsigned channels, uint64_t when)
@@ -409,7 +426,8 @@ static void test_gsnap_take(enc_qei_dev_t *d)
         CHECK(err == ENC_QEI_DRV_OK, "gsnap_take returned %d (%s)", err, enc_qei_drv_strerror(err));
         CHECK(m.ntaken == taken0 + 1u, "gsnap_take took %u snapshots", m.ntaken - taken0);
         when = m.taken[m.ntaken - 1u];
-        CHECK(t == ((uint32_t)when & tmask()), "GSNAP_TIME %" PRIu32 ", the snapshot's tick %" PRIu64,
+        CHECK(t == ((uint32_t)when & tmask()),
+              "GSNAP_TIME %" PRIu32 ", the snapshot's tick %" PRIu64,
               t, when);
         CHECK(when > last, "not a new snapshot");
         last = when;
@@ -470,7 +488,8 @@ static void test_irq_and_events(enc_qei_dev_t *d)
     enc_qei_drv_irq_enable(d, k, a);
     enc_qei_drv_irq_enable(d, k, b);
     settle();
-    CHECK(m.irq_en[k] == (a | b), "IRQ_EN 0x%" PRIx32 " after enabling 0x%" PRIx32 " then 0x%" PRIx32,
+    CHECK(m.irq_en[k] == (a | b),
+          "IRQ_EN 0x%" PRIx32 " after enabling 0x%" PRIx32 " then 0x%" PRIx32,
           m.irq_en[k], a, b);
     enc_qei_drv_irq_disable(d, k, a);
     settle();
@@ -584,7 +603,8 @@ int main(int argc, char **argv)
         if (a[3]) {
             a0 = m.accesses;
             test_gsnap_take(&d);
-            printf("gsnap_take accesses/channel %.1f\n", (double)(m.accesses - a0) / 5.0 / d.channels);
+            printf("gsnap_take accesses/channel %.1f\n",
+                   (double)(m.accesses - a0) / 5.0 / d.channels);
             test_snap_take(&d);
             test_timeout(&d);
             test_servo(8u);

@@ -42,7 +42,8 @@ def model(tmp_path_factory):
 def run(exe: Path, *args) -> str:
     res = subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=60)
     out = res.stdout
-    assert res.returncode == 0 and "failures 0" in out, f"drv_model {' '.join(map(str, args))}:\n{out}{res.stderr}"
+    assert res.returncode == 0 and "failures 0" in out, \
+        f"drv_model {' '.join(map(str, args))}:\n{out}{res.stderr}"
     return out
 
 
@@ -67,7 +68,8 @@ BUILDS = [
 ]
 
 
-@pytest.mark.parametrize("build", BUILDS, ids=lambda b: "ch{}_cw{}_tw{}_t{}_f{}_lat{}_stg{}".format(*b))
+@pytest.mark.parametrize("build", BUILDS,
+                         ids=lambda b: "ch{}_cw{}_tw{}_t{}_f{}_lat{}_stg{}".format(*b))
 def test_driver_against_the_model(model, build):
     """Positions, IRQ_EN without read-modify-write, events taken once, command snapshots (global
     and per channel, also with a stale one pending), SNAP_CTRL kept, ESKEW, the bounded wait, the
@@ -83,7 +85,7 @@ def test_driver_random_builds(model):
     rng = random.Random(seed)
     for _ in range(6):
         timing = rng.random() < 0.8
-        build = (rng.randint(1, 16), rng.choice([8, 16, 32, 33, 48, 63, 64]), rng.choice([16, 24, 32]),
-                 int(timing), int(timing and rng.random() < 0.5), rng.choice([0, 1, 3, 50]),
-                 rng.choice([0, 1, 13]))
+        build = (rng.randint(1, 16), rng.choice([8, 16, 32, 33, 48, 63, 64]),
+                 rng.choice([16, 24, 32]), int(timing), int(timing and rng.random() < 0.5),
+                 rng.choice([0, 1, 3, 50]), rng.choice([0, 1, 13]))
         run(model, "run", *build)

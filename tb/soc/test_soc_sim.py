@@ -2,9 +2,9 @@
 """enc_qei in a simulated LiteX SoC, its firmware against the motion model (`make soc-sim`).
 
 The SoC (VexRiscv, ROM, SRAM, UART, 4 full channels driven by tools/enctools/litex/motion.py)
-runs sw/soc/main.c: discovery from ID and CAPS through the driver API, the 1 kHz global snapshot,
-the interrupt handler's positions and velocities, a command snapshot at the end. enctools.litex.check
-compares what it printed with the model (its docstring states the velocity bound); the firmware
+runs sw/soc/main.c: discovery from ID and CAPS through the driver API, the 1 kHz global
+snapshot, the interrupt handler's positions and velocities, a command snapshot at the end.
+enctools.litex.check compares what it printed with the model (its docstring states the velocity bound); the firmware
 runs twice, with the fixed-point estimator (the default: its readings within one unit of the
 double estimator on the model's registers, in fewer than 500 cycles a channel, no floating point
 linked) and with the double one (FW_VEL=double). The firmware built with FW_FAULT=page reads one
@@ -108,7 +108,8 @@ def test_fixed_point_readings_held_to_one_unit(good):
         r2 = copy.deepcopy(run)
         i = len(r2.rows) // 2
         n, t, lat, cyc, pos, vel = r2.rows[i]
-        r2.rows[i] = (n, t, lat, cyc, pos, [v + du / 256 if k == 1 else v for k, v in enumerate(vel)])
+        vel = [v + du / 256 if k == 1 else v for k, v in enumerate(vel)]
+        r2.rows[i] = (n, t, lat, cyc, pos, vel)
         assert check.check(CFG.motions(), r2, delay=res.delay).ok is ok, du
 
 

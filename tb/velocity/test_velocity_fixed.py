@@ -7,11 +7,13 @@ units of 2^-F count steps per second, must be within one unit of the double read
 (clipped to the stated range, +-(2^31 - 1) units: beyond it the fixed point saturates), and
 exactly 0 wherever the double reading is exactly 0 (the rules, not the arithmetic, make those).
 The header promises half a unit; the tests print the largest error seen. qei_velfx_update_mt()
-(the timestamp method alone) must read exactly what qei_velfx_update() reads for MT, everywhere. Inputs: modelled
-HEDS-5000 snapshot streams (as the agreement test of the double version), random streams with
-timebase and count wraps at several widths, standstill, reversals, jumps, period flags and stall,
-and hand-made edge cases (saturation, rounding ties, extreme tick rates and F). Every hand-made
-rule case of test_velocity_estimators.py also goes through this check (its both()).
+(the timestamp method alone) must read exactly what qei_velfx_update() reads for MT, everywhere.
+Inputs: modelled HEDS-5000 snapshot streams (as the agreement test of the double version), random
+streams with timebase and count wraps at several widths, standstill, reversals, jumps, period
+flags and stall, and hand-made edge cases (saturation, rounding ties, extreme tick rates and F).
+Every hand-made rule case of test_velocity_estimators.py also goes through this check (its
+both()). The arithmetic (division, rounding, saturation) is also checked on its own against
+Python's integers.
 """
 
 from __future__ import annotations

@@ -25,7 +25,8 @@ static int units(void)
     qei_velfx_t st;
     qei_velfx_cfg_t cfg = {1u, 0u, 32u, 32u, 1u, 0u, 0};
     while (scanf("%7s", kind) == 1) {
-        if (strcmp(kind, "div") == 0 && scanf("%" SCNu64 " %" SCNu64 " %" SCNu64, &a, &b, &c) == 3) {
+        if (strcmp(kind, "div") == 0 &&
+            scanf("%" SCNu64 " %" SCNu64 " %" SCNu64, &a, &b, &c) == 3) {
             printf("%" PRIu32 "\n", divlu((uint32_t)a, (uint32_t)b, (uint32_t)c));
         } else if (strcmp(kind, "ratio") == 0 &&
                    scanf("%" SCNu64 " %" SCNu64 " %" SCNu64, &a, &b, &c) == 3) {

@@ -306,19 +306,23 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
         if not crossed and latch != 0:
             fail("index", f"channel {k}: INDEX_LATCH {latch} without an index")
 
+    if unit:
+        kind = f"fixed point, 2^-{run.build['vel'][2:]} count/s"
+        equal = f"within one unit (largest difference {dev / unit:.3f} unit)"
+    else:
+        kind, equal = "double", "to the printed 0.001 count/s"
+    gsnap_ok = run.gsnap and not [m for w, m in fails if w == "gsnap"]
     summary = [
         f"{len(times)} snapshots x {nch} channels: positions exact for delay D = {d} "
         f"(D consistent with every position: {delays[0] if delays else '-'}.."
         f"{delays[-1] if delays else '-'} clocks)",
-        f"velocity ({'fixed point, 2^-' + run.build['vel'][2:] + ' count/s' if unit else 'double'}): "
-        f"{nvel} readings equal the estimator on the model's registers "
-        f"{f'within one unit (largest difference {dev / unit:.3f} unit)' if unit else 'to the printed 0.001 count/s'} (edge "
-        f"timestamps {sorted(offsets)} clocks from the count's step); {nzero} are its documented "
-        f"0; {nbound} within the bound (worst error/bound {worst:.6f}; {worst_const:.6f} at "
-        f"constant speed)",
+        f"velocity ({kind}): {nvel} readings equal the estimator on the model's registers "
+        f"{equal} (edge timestamps {sorted(offsets)} clocks from the count's step); {nzero} are "
+        f"its documented 0; {nbound} within the bound (worst error/bound {worst:.6f}; "
+        f"{worst_const:.6f} at constant speed)",
         f"snapshots: gaps {sorted(set(int(g) for g in gaps))} ticks, missed/torn/skewed/driver "
         f"errors {run.misses}; the command snapshot (enc_qei_drv_gsnap_take) "
-        f"{'equals the model' if run.gsnap and not [m for w, m in fails if w == 'gsnap'] else 'FAILS'}",
+        f"{'equals the model' if gsnap_ok else 'FAILS'}",
     ]
     return Result(not fails, fails, delays, d, len(times) * nch, nvel, nbound, nzero, worst,
                   worst_const, summary)

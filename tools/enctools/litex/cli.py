@@ -91,7 +91,10 @@ def unmapped_line(run: check.Run) -> str:
             f"{u['bus_errors']} bus error")
 
 
-def handler_section(fixed: check.Run, double: check.Run, fixed_sf: list, double_sf: list) -> list[str]:
+def handler_section(fixed: check.Run, double: check.Run, fixed_sf: list,
+                    double_sf: list) -> list[str]:
+    """The handler-cycles section of the results: both estimators' tables and what they mean.
+    ``*_sf``: the soft-float routines each firmware links."""
     clk, period = fixed.build["clk_hz"], fixed.build["period"]
     fx, db = PerChannel.of(fixed), PerChannel.of(double)
     n16 = fx.handler(GOAL_CHANNELS)
