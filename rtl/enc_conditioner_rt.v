@@ -3,13 +3,16 @@
 // with the filter length as a run-time input (enc_qei's CTRL.FILTER_LEN). enc_conditioner, the
 // contract's fixed-length block, is this module with the length tied to its FILTER_LEN.
 //
-// Per channel:
+// Per channel (enc_filter_rt):
 //   a_in -> two flip-flops (synchronizer) -> filter_len-sample filter -> a
 // The filter output takes a new level only after the synchronized input has shown that level on
 // filter_len consecutive clocks; a level that goes back sooner is rejected and `glitch` pulses
 // for one clock (never with filter_len = 1). An output changes filter_len + 1 clocks after the
 // rising edge that first samples the new level. `valid` rises filter_len + 2 clocks after rst
 // falls (hold a decoder behind this block in reset while it is low).
+// SETTLE = 0 leaves the settling chain out (valid is then 1): for a caller that knows when every
+// input has settled from one shared chain (the shared engine's lanes, whose filter length cannot
+// change before the chain's reset value has settled).
 // filter_len is clamped to 1 .. MAX_FILTER_LEN (0 acts as 1) through a register, so a new value
 // acts from the clock after it appears (the reset value is in place when rst falls, so the
 // timings above hold from reset). It may change at any time: a
@@ -19,7 +22,8 @@
 `include "enc_params.vh"
 
 module enc_conditioner_rt #(
-    parameter integer MAX_FILTER_LEN = 16  // largest filter_len used: 1 .. 16 (sizes the counters)
+    parameter integer MAX_FILTER_LEN = 16,  // largest filter_len used: 1 .. 16 (sizes the counters)
+    parameter integer SETTLE         = 1    // 1: valid from the settling chain; 0: no chain, valid = 1
 ) (
     input  wire       clk,
     input  wire       rst,         // synchronous, active high
@@ -54,100 +58,78 @@ module enc_conditioner_rt #(
     last5_q <= (len_m1 > MAX_LAST5) ? MAX_LAST5 : len_m1;
   end
 
-  // ---- synchronizer: two flip-flops per channel -----------------------------------------------
-  reg [1:0] meta_q;  // {b, a} first stage
-  reg [1:0] sync_q;  // {b, a} second stage
-
-  always @(posedge clk) begin
-    if (rst) begin
-      meta_q <= 2'b00;
-      sync_q <= 2'b00;
-    end else begin
-      meta_q <= {b_in, a_in};
-      sync_q <= meta_q;
-    end
-  end
-
-  // ---- filter: the same logic for each channel ------------------------------------------------
+  // ---- synchronizer and filter of each channel ------------------------------------------------
   wire [1:0] level;   // {b, a} accepted levels
   wire [1:0] reject;  // this clock a candidate level went back before it was accepted
 
-  genvar ch;
+  enc_filter_rt #(
+      .CW      (CW),
+      .MAX_LAST(MAX_LAST_INT)
+  ) u_filter_a (
+      .clk   (clk),
+      .rst   (rst),
+      .last  (last),
+      .in    (a_in),
+      .level (level[0]),
+      .reject(reject[0])
+  );
+
+  enc_filter_rt #(
+      .CW      (CW),
+      .MAX_LAST(MAX_LAST_INT)
+  ) u_filter_b (
+      .clk   (clk),
+      .rst   (rst),
+      .last  (last),
+      .in    (b_in),
+      .level (level[1]),
+      .reject(reject[1])
+  );
+
+  // ---- settling after reset: 2 synchronizer clocks + filter_len filter clocks ------------------
+  // A chain of flip-flops filling with ones after rst; valid is the stage filter_len + 1.
   generate
-    for (ch = 0; ch < 2; ch = ch + 1) begin : g_filter
-      reg          level_q;
-      reg          level_d;
-      reg [CW-1:0] run_q;
-      reg [CW-1:0] run_d;
-      reg          reject_d;
+    if (SETTLE != 0) begin : g_settle
+      localparam integer SETTLE_N = MAX_FILTER_LEN + 2;
+      reg [SETTLE_N-1:0] settle_q;
+
+      always @(posedge clk) begin
+        if (rst) begin
+          settle_q <= {SETTLE_N{1'b0}};
+        end else begin
+          settle_q <= {settle_q[SETTLE_N-2:0], 1'b1};
+        end
+      end
+
+      // valid = settle_q[last5 + 2] (1 from the clock after edge filter_len + 2 after rst, the clock
+      // the filter first shows the inputs), taken as a register of settle_q[last5 + 1] (the same
+      // value, one stage on: the tap's multiplexer is not in front of the decoders' reset; Fmax). A
+      // loop, so the index needs no width of its own.
+      reg        tap_d;
+      reg        valid_d;
+      integer    i;
 
       always @(*) begin
-        level_d  = level_q;
-        run_d    = run_q;
-        reject_d = 1'b0;
-        if (sync_q[ch] != level_q) begin
-          if (run_q >= last) begin
-            level_d = sync_q[ch];  // filter_len-th consecutive sample of the new level: accept
-            run_d   = {CW{1'b0}};
-          end else begin
-            run_d = run_q + 1'b1;
-          end
-        end else if (run_q != {CW{1'b0}}) begin
-          run_d    = {CW{1'b0}};   // back to the accepted level too soon: reject
-          reject_d = 1'b1;
+        tap_d = 1'b0;
+        for (i = 0; i < SETTLE_N - 1; i = i + 1) begin
+          if (last5 == i[4:0]) tap_d = settle_q[i + 1];
         end
       end
 
       always @(posedge clk) begin
         if (rst) begin
-          level_q <= 1'b0;
-          run_q   <= {CW{1'b0}};
+          valid_d <= 1'b0;
         end else begin
-          level_q <= level_d;
-          run_q   <= run_d;
+          valid_d <= tap_d;
         end
       end
 
-      assign level[ch]  = level_q;
-      assign reject[ch] = reject_d;
+      assign valid = valid_d;
+    end else begin : g_no_settle
+      wire unused_last5 = &{1'b0, last5};  // (the filters use the low bits only)
+      assign valid = 1'b1;
     end
   endgenerate
-
-  // ---- settling after reset: 2 synchronizer clocks + filter_len filter clocks ------------------
-  // A chain of flip-flops filling with ones after rst; valid is the stage filter_len + 1.
-  localparam integer SETTLE = MAX_FILTER_LEN + 2;
-  reg [SETTLE-1:0] settle_q;
-
-  always @(posedge clk) begin
-    if (rst) begin
-      settle_q <= {SETTLE{1'b0}};
-    end else begin
-      settle_q <= {settle_q[SETTLE-2:0], 1'b1};
-    end
-  end
-
-  // valid = settle_q[last5 + 2] (1 from the clock after edge filter_len + 2 after rst, the clock
-  // the filter first shows the inputs), taken as a register of settle_q[last5 + 1] (the same
-  // value, one stage on: the tap's multiplexer is not in front of the decoders' reset; Fmax). A
-  // loop, so the index needs no width of its own.
-  reg        tap_d;
-  reg        valid_d;
-  integer    i;
-
-  always @(*) begin
-    tap_d = 1'b0;
-    for (i = 0; i < SETTLE - 1; i = i + 1) begin
-      if (last5 == i[4:0]) tap_d = settle_q[i + 1];
-    end
-  end
-
-  always @(posedge clk) begin
-    if (rst) begin
-      valid_d <= 1'b0;
-    end else begin
-      valid_d <= tap_d;
-    end
-  end
 
   reg glitch_q;
 
@@ -162,14 +144,13 @@ module enc_conditioner_rt #(
   assign a      = level[0];
   assign b      = level[1];
   assign glitch = glitch_q;
-  assign valid  = valid_d;
 
 `ifdef FORMAL
   // ---- formal only (formal/enc_conditioner_rt.sby, enc_conditioner.sby): invariants, asserts
   // only. The port-level properties are in the formal wrappers. These bound the registers to
-  // their reachable values so that induction (here and in a parent) needs no long traces: each
-  // run-length counter stays below MAX_FILTER_LEN, and the settling chain fills with ones from
-  // bit 0 (a thermometer code).
+  // their reachable values so that induction (here and in a parent) needs no long traces: the
+  // filter length stays below MAX_FILTER_LEN (each filter's run counter: enc_filter_rt), and the
+  // settling chain fills with ones from bit 0 (a thermometer code).
   reg f_rst_seen = 1'b0;  // a rst has happened: the registers are defined
   always @(posedge clk) begin
     if (rst) f_rst_seen <= 1'b1;
@@ -177,11 +158,19 @@ module enc_conditioner_rt #(
 
   always @(*) begin
     if (f_rst_seen) begin
-      assert ({1'b0, g_filter[0].run_q} <= MAX_LAST_INT && {1'b0, g_filter[1].run_q} <= MAX_LAST_INT);
-      assert (((settle_q >> 1) & ~settle_q) == {SETTLE{1'b0}});
       assert (last5_q <= MAX_LAST5);
     end
   end
+
+  generate
+    if (SETTLE != 0) begin : g_settle_invariant
+      always @(*) begin
+        if (f_rst_seen) begin
+          assert (((g_settle.settle_q >> 1) & ~g_settle.settle_q) == {(MAX_FILTER_LEN + 2){1'b0}});
+        end
+      end
+    end
+  endgenerate
 `endif
 
 endmodule

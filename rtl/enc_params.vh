@@ -17,6 +17,7 @@
 `define ENC_CHECK_CHANNELS if (CHANNELS < 1 || CHANNELS > 16) begin : g_bad_channels enc__parameter_CHANNELS_must_be_1_to_16 u_stop (); end
 `define ENC_CHECK_ADDR_W if (ADDR_W < 8 || ADDR_W > 16) begin : g_bad_addr_w enc__parameter_ADDR_W_must_be_8_to_16 u_stop (); end
 `define ENC_CHECK_EFIFO_LOG2 if (EFIFO_LOG2 < 0 || EFIFO_LOG2 > 8) begin : g_bad_efifo_log2 enc__parameter_EFIFO_LOG2_must_be_0_to_8 u_stop (); end
+`define ENC_CHECK_ENGINE if (ENGINE < 0 || ENGINE > 1) begin : g_bad_engine enc__parameter_ENGINE_must_be_0_to_1 u_stop (); end
 `define ENC_CHECK_FUNC_MASK if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask enc__parameter_FUNC_MASK_must_be_1_to_511 u_stop (); end
 `define ENC_CHECK_MAX_FILTER_LEN if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len enc__parameter_MAX_FILTER_LEN_must_be_1_to_16 u_stop (); end
 `define ENC_CHECK_POS_WIDTH if (POS_WIDTH < 8 || POS_WIDTH > 31) begin : g_bad_pos_width enc__parameter_POS_WIDTH_must_be_8_to_31 u_stop (); end
@@ -35,6 +36,7 @@
 `define ENC_CHECK_CHANNELS if (CHANNELS < 1 || CHANNELS > 16) begin : g_bad_channels $error("parameter CHANNELS must be in 1 .. 16"); end
 `define ENC_CHECK_ADDR_W if (ADDR_W < 8 || ADDR_W > 16) begin : g_bad_addr_w $error("parameter ADDR_W must be in 8 .. 16"); end
 `define ENC_CHECK_EFIFO_LOG2 if (EFIFO_LOG2 < 0 || EFIFO_LOG2 > 8) begin : g_bad_efifo_log2 $error("parameter EFIFO_LOG2 must be in 0 .. 8"); end
+`define ENC_CHECK_ENGINE if (ENGINE < 0 || ENGINE > 1) begin : g_bad_engine $error("parameter ENGINE must be in 0 .. 1"); end
 `define ENC_CHECK_FUNC_MASK if (FUNC_MASK < 1 || FUNC_MASK > 511) begin : g_bad_func_mask $error("parameter FUNC_MASK must be in 1 .. 511"); end
 `define ENC_CHECK_MAX_FILTER_LEN if (MAX_FILTER_LEN < 1 || MAX_FILTER_LEN > 16) begin : g_bad_max_filter_len $error("parameter MAX_FILTER_LEN must be in 1 .. 16"); end
 `define ENC_CHECK_POS_WIDTH if (POS_WIDTH < 8 || POS_WIDTH > 31) begin : g_bad_pos_width $error("parameter POS_WIDTH must be in 8 .. 31"); end

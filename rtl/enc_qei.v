@@ -27,6 +27,10 @@
 //                            period capture, stall or per-channel unit timer; COUNT_W >= 32
 //   EFIFO_LOG2 0: no edge-capture FIFO; 1 .. 8: every channel has one of 2^EFIFO_LOG2 entries
 //              (CAPS.EFIFO_LOG2, EFIFO_* registers); needs the timing unit (PROFILE full or lean)
+//   ENGINE     0 per_channel: enc_qei_channel x CHANNELS, as above; 1 shared: enc_qei_engine, one
+//              engine that keeps every channel's registers in block RAM and visits them in turn,
+//              with a small lane per channel for what must see every clock (CAPS.ENGINE; the
+//              RDL gives what it shows later, and by how many clocks at most)
 //   FUNC_MASK  the count functions built, bit F for CTRL.FUNC value F (default: all). With one
 //              bit set the function is fixed: CTRL.FUNC reads it and ignores writes, and the
 //              decode logic of the others is left out. With several, a CTRL.FUNC value outside
@@ -41,7 +45,8 @@ module enc_qei #(
     parameter integer TS_W       = 32,   // timebase / timestamp width in bits
     parameter integer PROFILE    = 2,    // 2 full, 1 counting, 3 lean (see above)
     parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL,  // count functions built: bit F = CTRL.FUNC value F
-    parameter integer EFIFO_LOG2 = 0     // edge-capture FIFO of 2^EFIFO_LOG2 entries per channel, 0: none
+    parameter integer EFIFO_LOG2 = 0,    // edge-capture FIFO of 2^EFIFO_LOG2 entries per channel, 0: none
+    parameter integer ENGINE     = 0     // 0: a datapath per channel, 1: one shared engine (see above)
 ) (
     input  wire                clk,
     input  wire                rst,         // synchronous, active high
@@ -70,6 +75,7 @@ module enc_qei #(
     `ENC_CHECK_PROFILE
     `ENC_CHECK_FUNC_MASK
     `ENC_CHECK_EFIFO_LOG2
+    `ENC_CHECK_ENGINE
     // (ADDR_W must hold the pages: a relation enc_ip.core's ranges cannot hold)
     if ((1 << (ADDR_W - 8)) < CHANNELS) begin : g_bad_addr_w_pages
 `ifdef __ICARUS__
@@ -99,6 +105,14 @@ module enc_qei #(
       enc_qei__parameter_COUNT_W_must_be_at_least_32_with_PROFILE_lean u_stop ();
 `else
       $error("enc_qei: PROFILE lean (3) needs COUNT_W of at least 32");
+`endif
+    end
+    // (the shared engine builds the lean profile, without the edge FIFO)
+    if (ENGINE != 0 && (PROFILE != P_LEAN || EFIFO_LOG2 != 0)) begin : g_bad_engine_build
+`ifdef __ICARUS__
+      enc_qei__parameter_ENGINE_1_needs_PROFILE_lean_and_EFIFO_LOG2_0 u_stop ();
+`else
+      $error("enc_qei: parameter ENGINE = 1 (shared) builds PROFILE 3 (lean) with EFIFO_LOG2 = 0");
 `endif
     end
     // (the edge FIFO timestamps with the timing unit's timebase)
@@ -142,7 +156,32 @@ module enc_qei #(
   wire [CHANNELS*ENC_QEI_H2R_CH_W-1:0] hw2reg_ch;
   `include "enc_qei_regs_fields.vh"
 
+  // With the shared engine, a request for a channel register of a built page goes to the engine;
+  // everything else (the global registers, unmapped offsets: their error) to the register block.
+  function [15:0] zext16;
+    input [ADDR_W-1:0] a;
+    begin
+      zext16 = 16'd0;
+      zext16[ADDR_W-1:0] = a;
+    end
+  endfunction
+
+  wire [15:0] addr16 = zext16(req_addr);
+  wire        is_glb = (addr16[15:8] == 8'd0) &
+                       ((addr16[7:2] == ENC_QEI_ID[7:2]) | (addr16[7:2] == ENC_QEI_CAPS[7:2]) |
+                        (addr16[7:2] == ENC_QEI_TIMEBASE[7:2]) | (addr16[7:2] == ENC_QEI_TB_PRESCALE[7:2]) |
+                        (addr16[7:2] == ENC_QEI_GSNAP_CTRL[7:2]) | (addr16[7:2] == ENC_QEI_GSNAP_PERIOD[7:2]) |
+                        (addr16[7:2] == ENC_QEI_GSNAP_TIME[7:2]) | (addr16[7:2] == ENC_QEI_IRQ_SUMMARY[7:2]));
+  wire        to_eng = (ENGINE != 0) & ~is_glb & enc_qei_mapped(addr16, CHANNELS);
+  wire        regs_resp_valid, regs_resp_err, eng_resp_valid;
+  wire [31:0] regs_resp_rdata, eng_resp_rdata;
+
+  assign resp_valid = regs_resp_valid | eng_resp_valid;
+  assign resp_rdata = regs_resp_rdata | eng_resp_rdata;
+  assign resp_err   = regs_resp_err;
+
   enc_qei_regs #(
+      .CH_PAGES  ((ENGINE == 0) ? 1 : 0),
       .TIMING    (TIMING),
       .RANGE     (RANGE),
       .PROBE     (PROBE),
@@ -156,14 +195,14 @@ module enc_qei #(
   ) u_regs (
       .clk       (clk),
       .rst       (rst),
-      .req_valid (req_valid),
+      .req_valid (req_valid & ~to_eng),
       .req_write (req_write),
       .req_addr  (req_addr),
       .req_wdata (req_wdata),
       .req_wstrb (req_wstrb),
-      .resp_valid(resp_valid),
-      .resp_rdata(resp_rdata),
-      .resp_err  (resp_err),
+      .resp_valid(regs_resp_valid),
+      .resp_rdata(regs_resp_rdata),
+      .resp_err  (regs_resp_err),
       .reg2hw_g  (reg2hw_g),
       .hw2reg_g  (hw2reg_g),
       .reg2hw_ch (reg2hw_ch),
@@ -175,6 +214,7 @@ module enc_qei #(
   localparam [2:0] PROFILE3   = PROFILE[2:0];
   localparam [4:0] CHANNELS5  = CHANNELS[4:0];
   localparam [3:0] EFIFO_LOG24 = EFIFO_LOG2[3:0];
+  localparam [0:0] ENGINE1     = ENGINE[0:0];
 
   assign h2r_caps_count_w  = COUNT_W8;
   assign h2r_caps_ts_w     = TS_W8;
@@ -184,10 +224,12 @@ module enc_qei #(
   assign h2r_caps_profile  = PROFILE3;
   assign h2r_caps_channels = CHANNELS5;
   assign h2r_caps_efifo_log2 = EFIFO_LOG24;
+  assign h2r_caps_engine     = ENGINE1;
 
   // ---- the timebase and the global snapshot: one for every channel -------------------------
   wire [TS_W-1:0] timebase;
-  wire            tick, gsnap;
+  wire            tick, gsnap_req;
+  wire            gsnap;  // the global snapshot is taken (the engine may take a request late)
 
   generate
     if (TIMING != 0) begin : g_timebase
@@ -215,7 +257,7 @@ module enc_qei #(
           .in_en    (r2h_gsnap_ctrl_in_en),
           .period_en(r2h_gsnap_ctrl_period_en),
           .period   (r2h_gsnap_period[TS_W-1:0]),
-          .req      (gsnap)
+          .req      (gsnap_req)
       );
 
       always @(posedge clk) begin
@@ -230,7 +272,7 @@ module enc_qei #(
     end else begin : g_no_timebase
       assign timebase       = {TS_W{1'b0}};
       assign tick           = 1'b0;
-      assign gsnap          = 1'b0;
+      assign gsnap_req      = 1'b0;
       assign h2r_gsnap_time = 32'd0;
     end
   endgenerate
@@ -242,32 +284,72 @@ module enc_qei #(
 
   genvar ch;
   generate
-    for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
-      enc_qei_channel #(
+    if (ENGINE == 0) begin : g_per_channel
+      assign gsnap          = gsnap_req;
+      assign eng_resp_valid = 1'b0;
+      assign eng_resp_rdata = 32'd0;
+
+      for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
+        enc_qei_channel #(
+            .COUNT_W   (COUNT_W),
+            .TS_W      (TS_W),
+            .FUNC_MASK (FUNC_MASK),
+            .FIXED_FUNC(FIXED_FUNC),
+            .TIMING    (TIMING),
+            .RANGE     (RANGE),
+            .PROBE     (PROBE),
+            .PERIOD    (PERIOD),
+            .EFIFO_LOG2(EFIFO_LOG2)
+        ) u_chan (
+            .clk     (clk),
+            .rst     (rst),
+            .reg2hw  (reg2hw_ch[ch*ENC_QEI_R2H_CH_W +: ENC_QEI_R2H_CH_W]),
+            .hw2reg  (hw2reg_ch[ch*ENC_QEI_H2R_CH_W +: ENC_QEI_H2R_CH_W]),
+            .a_in    (a_in[ch]),
+            .b_in    (b_in[ch]),
+            .z_in    (z_in[ch]),
+            .probe_in(probe_in[ch]),
+            .snap_in (snap_in),
+            .timebase(timebase),
+            .tick    (tick),
+            .gsnap   (gsnap),
+            .cmp_out (cmp_out[ch]),
+            .irq_pend(irq_pend[ch])
+        );
+      end
+    end else begin : g_engine
+      // (the channel pages are the engine's: the register block has none)
+      wire unused_pages = &{1'b0, reg2hw_ch, probe_in, tick};
+      for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_no_page
+        assign hw2reg_ch[ch*ENC_QEI_H2R_CH_W +: ENC_QEI_H2R_CH_W] = {ENC_QEI_H2R_CH_W{1'b0}};
+      end
+      assign cmp_out   = {CHANNELS{1'b0}};
+
+      enc_qei_engine #(
+          .CHANNELS  (CHANNELS),
           .COUNT_W   (COUNT_W),
           .TS_W      (TS_W),
           .FUNC_MASK (FUNC_MASK),
-          .FIXED_FUNC(FIXED_FUNC),
-          .TIMING    (TIMING),
-          .RANGE     (RANGE),
-          .PROBE     (PROBE),
-          .PERIOD    (PERIOD),
-          .EFIFO_LOG2(EFIFO_LOG2)
-      ) u_chan (
-          .clk     (clk),
-          .rst     (rst),
-          .reg2hw  (reg2hw_ch[ch*ENC_QEI_R2H_CH_W +: ENC_QEI_R2H_CH_W]),
-          .hw2reg  (hw2reg_ch[ch*ENC_QEI_H2R_CH_W +: ENC_QEI_H2R_CH_W]),
-          .a_in    (a_in[ch]),
-          .b_in    (b_in[ch]),
-          .z_in    (z_in[ch]),
-          .probe_in(probe_in[ch]),
-          .snap_in (snap_in),
-          .timebase(timebase),
-          .tick    (tick),
-          .gsnap   (gsnap),
-          .cmp_out (cmp_out[ch]),
-          .irq_pend(irq_pend[ch])
+          .FIXED_FUNC(FIXED_FUNC)
+      ) u_engine (
+          .clk       (clk),
+          .rst       (rst),
+          .req_valid (req_valid & to_eng),
+          .req_write (req_write),
+          .req_ch    (addr16[11:8]),
+          .req_word  (addr16[7:2]),
+          .req_wdata (req_wdata),
+          .req_wstrb (req_wstrb),
+          .resp_valid(eng_resp_valid),
+          .resp_rdata(eng_resp_rdata),
+          .a_in      (a_in),
+          .b_in      (b_in),
+          .z_in      (z_in),
+          .snap_in   (snap_in),
+          .timebase  (timebase),
+          .gsnap_req (gsnap_req),
+          .gsnap     (gsnap),
+          .irq_pend  (irq_pend)
       );
     end
   endgenerate

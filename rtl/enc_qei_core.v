@@ -2,20 +2,14 @@
 // enc_qei_core -- the counting core of enc_qei: decode, count function, range, index, probe,
 // compare and the events they raise.
 //
-// Inputs are the conditioned channels (enc_conditioner_rt outputs). Channel A and B go through
-// SWAP_AB then INV_A / INV_B, then into the library's decoders, held in reset while the
-// conditioner is not valid and for one clock after FUNC, SWAP_AB, INV_A or INV_B change:
-//   enc_x4_decoder    -> every valid transition (cnt, up) and the quadrature error
-//   enc_x1_hysteresis -> FUNC = x1_hyst (Figure 14)
-// The Linux count functions come from the x4 decoder's transitions and the levels of the
-// transition's present and previous sample (a1/a2, b1/b2 below, aligned with its outputs):
-//   x4 every transition; x2a/x2b transitions of A/B; x1a: A rising forward (+1), A falling
-//   backward (-1); x1b the same on B; pulse_dir / increase / decrease: rising edges of A (B = up).
+// Inputs are the conditioned channels (enc_conditioner_rt outputs). enc_qei_decode turns them
+// into the count function's steps (through SWAP_AB / INV_*, the library's decoders and the
+// Linux count functions), the edges and the qualified index edge; this module counts them.
 // Count priority in one clock: COUNT write > index preset > count step. Range modes: free,
 // modulo (0 .. CEILING), limit (stops at 0 / CEILING), non_recycle (stops until COUNT is
 // written). Every decoder output has latency 1 from its sample and the count step one more
-// register; the index edge detector is delayed the same, so an index acts in the clock of the
-// transition it sees.
+// register; the index edge is delayed the same, so an index acts in the clock of the transition
+// it sees.
 // For Fmax, the range's decisions (wrap, stop, hold at CEILING or 0), the zero test and the
 // loads are flag registers, set a clock ahead from the next count's candidates: CEILING acts two
 // clocks after it changes, RANGE and INDEX_CTRL one clock after, a load (a COUNT write) loads the
@@ -109,142 +103,39 @@ module enc_qei_core #(
     end
   endfunction
 
-  // ---- channel selection and decoder reset ----------------------------------------------------
-  wire a_sw = swap_ab ? b_c : a_c;
-  wire b_sw = swap_ab ? a_c : b_c;
-  assign a_eff = a_sw ^ inv_a;
-  assign b_eff = b_sw ^ inv_b;
-  assign z_eff = z_c ^ inv_z;
+  // ---- decode: the pins' transitions, the count function's steps and the index edge -------------
+  wire fdn, idx_hit1, idx_hit;  // (idx_hit1: the index edge one clock before idx_hit)
 
-  reg  [7:0] cfg_q;  // {func, swap_ab, inv_a, inv_b, inv_z} last clock
-  wire [7:0] cfg   = {func, swap_ab, inv_a, inv_b, inv_z};
-  wire       dec_rst = rst | ~valid | (cfg[7:1] != cfg_q[7:1]);
-  // a change of SWAP_AB, INV_A, INV_B or INV_Z re-references the index too: the level change it
-  // makes (of Z, or of the gate's A/B state) is not an index edge
-  wire       chan_cfg_change = (cfg[3:0] != cfg_q[3:0]);
-
-  always @(posedge clk) begin
-    if (rst) begin
-      cfg_q <= 8'd0;
-    end else begin
-      cfg_q <= cfg;
-    end
-  end
-
-  wire x4_cnt, x4_up, x4_err;
-  wire h_up, h_dn, h_err_unused;
-
-  enc_x4_decoder u_x4 (
-      .clk      (clk),
-      .rst      (dec_rst),
-      .a        (a_eff),
-      .b        (b_eff),
-      .cnt_pulse(x4_cnt),
-      .up       (x4_up),
-      .error    (x4_err)
+  enc_qei_decode u_dec (
+      .clk        (clk),
+      .rst        (rst),
+      .a_c        (a_c),
+      .b_c        (b_c),
+      .z_c        (z_c),
+      .valid      (valid),
+      .en         (en),
+      .swap_ab    (swap_ab),
+      .inv_a      (inv_a),
+      .inv_b      (inv_b),
+      .inv_z      (inv_z),
+      .func       (func),
+      .idx_edge   (idx_edge),
+      .idx_gate_en(idx_gate_en),
+      .idx_gate_a (idx_gate_a),
+      .idx_gate_b (idx_gate_b),
+      .a_eff      (a_eff),
+      .b_eff      (b_eff),
+      .z_eff      (z_eff),
+      .fdn        (fdn),
+      .step_up    (step_up),
+      .step_dn    (step_dn),
+      .edge_any   (edge_any),
+      .edge_a_rise(edge_a_rise),
+      .step_ab    (step_ab),
+      .qerr       (ev_qerr),
+      .idx_hit1   (idx_hit1),
+      .idx_hit    (idx_hit)
   );
-
-  enc_x1_hysteresis u_x1h (
-      .clk     (clk),
-      .rst     (dec_rst),
-      .a       (a_eff),
-      .b       (b_eff),
-      .up_pulse(h_up),
-      .dn_pulse(h_dn),
-      .error   (h_err_unused)  // the same condition as x4_err
-  );
-
-  // Levels of the present (1) and previous (2) sample of the transition the decoders report now,
-  // and A's rising edge for the pulse functions (registered like the decoders' outputs).
-  reg a1_q, a2_q, b1_q, b2_q, ok1_q, arise_q;
-
-  always @(posedge clk) begin
-    if (dec_rst) begin
-      ok1_q   <= 1'b0;
-      arise_q <= 1'b0;
-    end else begin
-      ok1_q   <= 1'b1;
-      arise_q <= ok1_q & a_eff & ~a1_q;
-    end
-    a1_q <= a_eff;
-    a2_q <= a1_q;
-    b1_q <= b_eff;
-    b2_q <= b1_q;
-  end
-
-  // ---- count function ---------------------------------------------------------------------------
-  wire a_moved = a1_q ^ a2_q;
-  wire b_moved = b1_q ^ b2_q;
-  reg  fup, fdn, quad;
-
-  always @(*) begin
-    fup  = 1'b0;
-    fdn  = 1'b0;
-    quad = 1'b1;
-    case (func)
-      ENC_QEI_FUNC_X4: begin
-        fup = x4_cnt & x4_up;
-        fdn = x4_cnt & ~x4_up;
-      end
-      ENC_QEI_FUNC_X2A: begin
-        fup = x4_cnt & a_moved & x4_up;
-        fdn = x4_cnt & a_moved & ~x4_up;
-      end
-      ENC_QEI_FUNC_X2B: begin
-        fup = x4_cnt & b_moved & x4_up;
-        fdn = x4_cnt & b_moved & ~x4_up;
-      end
-      ENC_QEI_FUNC_X1A: begin
-        fup = x4_cnt & a_moved & x4_up & a1_q;
-        fdn = x4_cnt & a_moved & ~x4_up & ~a1_q;
-      end
-      ENC_QEI_FUNC_X1B: begin
-        fup = x4_cnt & b_moved & x4_up & b1_q;
-        fdn = x4_cnt & b_moved & ~x4_up & ~b1_q;
-      end
-      ENC_QEI_FUNC_PULSE_DIR: begin
-        fup  = arise_q & b1_q;
-        fdn  = arise_q & ~b1_q;
-        quad = 1'b0;
-      end
-      ENC_QEI_FUNC_INCREASE: begin
-        fup  = arise_q;
-        quad = 1'b0;
-      end
-      ENC_QEI_FUNC_DECREASE: begin
-        fdn  = arise_q;
-        quad = 1'b0;
-      end
-      ENC_QEI_FUNC_X1_HYST: begin
-        fup = h_up;
-        fdn = h_dn;
-      end
-      default: quad = 1'b0;
-    endcase
-  end
-
-  // One register stage between the count function and the count (for Fmax): the steps, the
-  // edges and the index hit below are all delayed alike.
-  reg step_up_q, step_dn_q, edge_any_q, edge_a_rise_q;
-  reg [1:0] step_ab_q;  // {A, B} after the transition of this clock's step (not reset: a delay)
-
-  always @(posedge clk) begin
-    if (rst) begin
-      step_up_q     <= 1'b0;
-      step_dn_q     <= 1'b0;
-      edge_any_q    <= 1'b0;
-      edge_a_rise_q <= 1'b0;
-    end else begin
-      step_up_q     <= en & fup;
-      step_dn_q     <= en & fdn;
-      edge_any_q    <= x4_cnt;
-      edge_a_rise_q <= x4_cnt & a_moved & a1_q;
-    end
-  end
-
-  always @(posedge clk) begin
-    step_ab_q <= {a1_q, b1_q};
-  end
 
   // a copy of step_dn for the count's adder alone ((* keep *): Yosys would merge it back; Fmax:
   // one register driving the adder's carry chains and the range logic is a long net)
@@ -254,12 +145,6 @@ module enc_qei_core #(
     step_dn_add_q <= ~rst & en & fdn;
   end
 
-  assign step_up     = step_up_q;
-  assign step_dn     = step_dn_q;
-  assign edge_any    = edge_any_q;
-  assign edge_a_rise = edge_a_rise_q;
-  assign step_ab     = step_ab_q;
-  assign ev_qerr     = quad & x4_err;
 
   // ---- configuration, one clock late (Fmax) ---------------------------------------------------------
   // RANGE and INDEX_CTRL act one clock after they change, so that the decisions of the range
@@ -335,32 +220,21 @@ module enc_qei_core #(
   endfunction
 
   // ---- index ---------------------------------------------------------------------------------------
-  // Qualified index: Z and, with the gate, (A, B) = (GATE_A, GATE_B); the chosen edge of it acts.
-  wire idx_q      = z_eff & (~idx_gate_en | ((a_eff == idx_gate_a) & (b_eff == idx_gate_b)));
-  wire armed      = idx_arm_q & (idx_action_q != 2'd0);
-  reg  idx_prev_q, idx_ok_q, idx_hit1_q, idx_hit_q;
+  // The qualified index edge comes from the decode (idx_hit, aligned with the steps; idx_hit1 one
+  // clock earlier); here it acts on the count.
+  wire armed = idx_arm_q & (idx_action_q != 2'd0);
   // a latch hit, registered with the hit (from INDEX_CTRL as the next clock's idx_*_q show it)
-  reg  lat_hit_q;  // idx_hit_q & armed & ACTION = latch
-  wire idx_hit1_d = idx_ok_q & ~chan_cfg_change &
-                    (idx_edge ? (idx_prev_q & ~idx_q) : (~idx_prev_q & idx_q));
+  reg  lat_hit_q;  // idx_hit & armed & ACTION = latch
 
   always @(posedge clk) begin
     if (rst | ~valid) begin
-      idx_prev_q <= 1'b0;
-      idx_ok_q   <= 1'b0;
-      idx_hit1_q <= 1'b0;
-      idx_hit_q  <= 1'b0;
-      lat_hit_q  <= 1'b0;
+      lat_hit_q <= 1'b0;
     end else begin
-      idx_prev_q <= idx_q;
-      idx_ok_q   <= 1'b1;
-      idx_hit1_q <= idx_hit1_d;
-      idx_hit_q  <= idx_hit1_q;  // aligned with the step register above
-      lat_hit_q  <= idx_hit1_q & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_LATCH);
+      lat_hit_q <= idx_hit1 & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_LATCH);
     end
   end
 
-  wire idx_act = idx_hit_q & armed;
+  wire idx_act = idx_hit & armed;
 
   // ---- loads -----------------------------------------------------------------------------------------
   // COUNT writes and index presets, registered (Fmax): a COUNT write loads the count two clocks
@@ -383,7 +257,7 @@ module enc_qei_core #(
     end else begin
       wr_pend_q <= load;
       wr_q      <= wr_pend_q;
-      load_q    <= wr_pend_q | (valid & idx_hit1_q & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_PRESET));
+      load_q    <= wr_pend_q | (valid & idx_hit1 & idx_arm & (idx_action == ENC_QEI_INDEX_ACTION_PRESET));
     end
   end
 
@@ -685,7 +559,7 @@ module enc_qei_core #(
   assign applied_dn   = s_dec | s_ceil;
   assign ev_overflow  = ovf;
   assign ev_underflow = unf;
-  assign ev_index     = idx_hit_q;
+  assign ev_index     = idx_hit;
   assign ev_probe     = probe_hit_q;
   assign ev_cmp       = cmp_q;
   assign cmp_out      = cmp_q;
@@ -710,15 +584,13 @@ module enc_qei_core #(
   initial idx_action_q = 2'd0;
   initial idx_oneshot_q = 1'b0;
   initial stopped_q = 1'b0;
-  initial idx_hit_q = 1'b0;
   initial lat_hit_q = 1'b0;
-  initial step_dn_q = 1'b0;
   initial step_dn_add_q = 1'b0;
   always @(*) begin
     assert (load_zero_q == (load_val_q == {COUNT_W{1'b0}}));
-    assert (step_dn_add_q == step_dn_q);
-    assert (load_q == (wr_q | (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_PRESET))));
-    assert (lat_hit_q == (idx_hit_q & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_LATCH)));
+    assert (step_dn_add_q == step_dn);
+    assert (load_q == (wr_q | (idx_hit & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_PRESET))));
+    assert (lat_hit_q == (idx_hit & idx_arm_q & (idx_action_q == ENC_QEI_INDEX_ACTION_LATCH)));
     if (RANGE == 0) assert (range_q == ENC_QEI_RANGE_FREE && !stopped_q && !load_ge_q);
   end
 

@@ -23,6 +23,7 @@ module enc_qei_regs #(
     parameter integer PERIOD = 1,  // 1: unit PERIOD present, 0: its registers and fields read 0 (checked by enc_qei)
     parameter integer EFIFO = 1,  // 1: unit EFIFO present, 0: its registers and fields read 0 (checked by enc_qei)
     parameter integer FIXED_FUNC = -1,  // -1: the field is storage, >= 0: fixed to it (checked by enc_qei)
+    parameter integer CH_PAGES = 1,  // 1: channel pages here; 0: none (the shared engine's)
     parameter integer CHANNELS = 1,  // channel pages (checked by enc_qei)
     parameter integer ADDR_W   = 8,  // byte address bits, 8 .. 16 (checked by enc_qei)
     parameter integer COUNT_W  = 32, // counter width (checked by enc_qei)
@@ -42,7 +43,7 @@ module enc_qei_regs #(
     output wire        resp_err,    // no register at that address
     output wire [50:0] reg2hw_g,  // global registers to the hardware
     // verilator lint_off UNUSEDSIGNAL
-    input  wire [110:0] hw2reg_g,  // hardware to the global registers
+    input  wire [111:0] hw2reg_g,  // hardware to the global registers
     output wire [CHANNELS*403-1:0] reg2hw_ch,  // channel k: bits [k*403 +: 403]
     input  wire [CHANNELS*550-1:0] hw2reg_ch   // channel k: bits [k*550 +: 550]
     // verilator lint_on UNUSEDSIGNAL
@@ -117,7 +118,7 @@ module enc_qei_regs #(
   assign sel_c_d[34] = (off_d == ENC_QEI_EFIFO_ENTRY[7:2]);
   assign sel_c_d[35] = (off_d == ENC_QEI_EFIFO_TIME[7:2]);
   assign sel_c_d[36] = (off_d == ENC_QEI_EFIFO_LOST[7:2]);
-  wire chan_page_d = ({8'd0, page_d} < CHANNELS[15:0]);  // a channel's page
+  wire chan_page_d = (CH_PAGES != 0) & ({8'd0, page_d} < CHANNELS[15:0]);  // a channel's page
 
   // verilator lint_off UNUSEDSIGNAL
   reg [7:0] rd_g_q, wr_g_q;  // a read / write of global register k (read-only ones: unused)
@@ -228,6 +229,15 @@ module enc_qei_regs #(
 `endif
   genvar ch;
   generate
+    if (CH_PAGES == 0) begin : g_no_pages
+      wire unused_pages = &{1'b0, rd_c_q, wr_c_q, bmask, page_hit};
+      assign rd_ch = {CHANNELS*32{1'b0}};
+      assign reg2hw_ch = {CHANNELS*403{1'b0}};
+`ifdef FORMAL
+      assign f_view_ch = {CHANNELS*1184{1'b0}};
+      assign f_stage_ch = {CHANNELS*32{1'b0}};
+`endif
+    end else begin : g_pages
     for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
       // verilator lint_off UNUSEDSIGNAL
       wire [36:0] wr_c = wr_c_q & {37{page_hit[ch]}};  // writes to this page
@@ -1109,6 +1119,7 @@ module enc_qei_regs #(
     `endif
 
     end
+    end
   endgenerate
 
   // ---- read multiplexer (one select bit at most: AND-OR) and response -----------------
@@ -1130,9 +1141,10 @@ module enc_qei_regs #(
       rd_d[21:19] = rd_d[21:19] | hw2reg_g[21:19];  // CAPS.PROFILE
       rd_d[26:22] = rd_d[26:22] | hw2reg_g[26:22];  // CAPS.CHANNELS
       rd_d[30:27] = rd_d[30:27] | hw2reg_g[30:27];  // CAPS.EFIFO_LOG2
+      rd_d[31:31] = rd_d[31:31] | hw2reg_g[31];  // CAPS.ENGINE
     end
     if (rd_g_q[2]) begin  // TIMEBASE
-      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[62:31];  // TIMEBASE.VALUE
+      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[63:32];  // TIMEBASE.VALUE
     end
     if (rd_g_q[3]) begin  // TB_PRESCALE
       if (TIMING != 0) rd_d[15:0] = rd_d[15:0] | tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
@@ -1145,10 +1157,10 @@ module enc_qei_regs #(
       if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | gsnap_period_value_q;  // GSNAP_PERIOD.VALUE
     end
     if (rd_g_q[6]) begin  // GSNAP_TIME
-      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[94:63];  // GSNAP_TIME.VALUE
+      if (TIMING != 0) rd_d[31:0] = rd_d[31:0] | hw2reg_g[95:64];  // GSNAP_TIME.VALUE
     end
     if (rd_g_q[7]) begin  // IRQ_SUMMARY
-      rd_d[15:0] = rd_d[15:0] | hw2reg_g[110:95];  // IRQ_SUMMARY.PENDING
+      rd_d[15:0] = rd_d[15:0] | hw2reg_g[111:96];  // IRQ_SUMMARY.PENDING
     end
     for (k = 0; k < CHANNELS; k = k + 1) begin
       rd_d = rd_d | (rd_ch[k*32 +: 32] & {32{page_hit[k]}});
@@ -1169,13 +1181,14 @@ module enc_qei_regs #(
     f_view_g[51 +: 3] = hw2reg_g[21:19];  // CAPS.PROFILE
     f_view_g[54 +: 5] = hw2reg_g[26:22];  // CAPS.CHANNELS
     f_view_g[59 +: 4] = hw2reg_g[30:27];  // CAPS.EFIFO_LOG2
-    if (TIMING != 0) f_view_g[64 +: 32] = hw2reg_g[62:31];  // TIMEBASE.VALUE
+    f_view_g[63 +: 1] = hw2reg_g[31];  // CAPS.ENGINE
+    if (TIMING != 0) f_view_g[64 +: 32] = hw2reg_g[63:32];  // TIMEBASE.VALUE
     if (TIMING != 0) f_view_g[96 +: 16] = tb_prescale_prescale_q;  // TB_PRESCALE.PRESCALE
     if (TIMING != 0) f_view_g[129 +: 1] = gsnap_ctrl_in_en_q;  // GSNAP_CTRL.IN_EN
     if (TIMING != 0) f_view_g[130 +: 1] = gsnap_ctrl_period_en_q;  // GSNAP_CTRL.PERIOD_EN
     if (TIMING != 0) f_view_g[160 +: 32] = gsnap_period_value_q;  // GSNAP_PERIOD.VALUE
-    if (TIMING != 0) f_view_g[192 +: 32] = hw2reg_g[94:63];  // GSNAP_TIME.VALUE
-    f_view_g[224 +: 16] = hw2reg_g[110:95];  // IRQ_SUMMARY.PENDING
+    if (TIMING != 0) f_view_g[192 +: 32] = hw2reg_g[95:64];  // GSNAP_TIME.VALUE
+    f_view_g[224 +: 16] = hw2reg_g[111:96];  // IRQ_SUMMARY.PENDING
   end
 `endif
 

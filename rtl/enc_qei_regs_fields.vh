@@ -17,7 +17,8 @@ wire h2r_caps_timing;  // CAPS.TIMING
 wire [2:0] h2r_caps_profile;  // CAPS.PROFILE
 wire [4:0] h2r_caps_channels;  // CAPS.CHANNELS
 wire [3:0] h2r_caps_efifo_log2;  // CAPS.EFIFO_LOG2
+wire h2r_caps_engine;  // CAPS.ENGINE
 wire [31:0] h2r_timebase;  // TIMEBASE.VALUE
 wire [31:0] h2r_gsnap_time;  // GSNAP_TIME.VALUE
 wire [15:0] h2r_irq_summary_pending;  // IRQ_SUMMARY.PENDING
-assign hw2reg_g = {h2r_irq_summary_pending, h2r_gsnap_time, h2r_timebase, h2r_caps_efifo_log2, h2r_caps_channels, h2r_caps_profile, h2r_caps_timing, h2r_caps_probe, h2r_caps_index, h2r_caps_ts_w, h2r_caps_count_w};
+assign hw2reg_g = {h2r_irq_summary_pending, h2r_gsnap_time, h2r_timebase, h2r_caps_engine, h2r_caps_efifo_log2, h2r_caps_channels, h2r_caps_profile, h2r_caps_timing, h2r_caps_probe, h2r_caps_index, h2r_caps_ts_w, h2r_caps_count_w};

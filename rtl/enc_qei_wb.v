@@ -18,7 +18,8 @@ module enc_qei_wb #(
     parameter integer TS_W       = 32,  // timebase / timestamp width in bits
     parameter integer PROFILE    = 2,   // 2 full, 1 counting, 3 lean (see enc_qei)
     parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL, // count functions built: bit F = CTRL.FUNC value F (see enc_qei)
-    parameter integer EFIFO_LOG2 = 0     // edge-capture FIFO of 2^EFIFO_LOG2 entries per channel, 0: none (see enc_qei)
+    parameter integer EFIFO_LOG2 = 0,    // edge-capture FIFO of 2^EFIFO_LOG2 entries per channel, 0: none (see enc_qei)
+    parameter integer ENGINE     = 0     // 0: a datapath per channel, 1: one shared engine (see enc_qei)
 ) (
     input  wire        clk,
     input  wire        rst,       // synchronous, active high
@@ -50,6 +51,7 @@ module enc_qei_wb #(
     `ENC_CHECK_PROFILE
     `ENC_CHECK_FUNC_MASK
     `ENC_CHECK_EFIFO_LOG2
+    `ENC_CHECK_ENGINE
   endgenerate
 
   wire resp_valid, resp_err;
@@ -81,7 +83,8 @@ module enc_qei_wb #(
       .TS_W      (TS_W),
       .PROFILE   (PROFILE),
       .FUNC_MASK (FUNC_MASK),
-      .EFIFO_LOG2(EFIFO_LOG2)
+      .EFIFO_LOG2(EFIFO_LOG2),
+      .ENGINE    (ENGINE)
   ) u_qei (
       .clk       (clk),
       .rst       (rst),

@@ -1,35 +1,37 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /*
- * enc_qei_calib.h -- a self-calibrating velocity estimator fed by enc_qei's edge-capture FIFO
- * (C99, no malloc, no libm but sqrt).
+ * enc_qei_calib.h -- a self-calibrating velocity estimator fed by enc_qei's edge-capture FIFO,
+ * that uses what it has learnt only while the edges confirm it (C99, no malloc, no libm but
+ * sqrt and fabs).
  *
  * The same algorithm as python/src/hedsmodel/calibration.py, operation for operation, in double
  * precision; tb/velocity/test_velocity_calibration.py compiles this file with gcc -std=c99 -Wall
  * -Wextra -Werror -pedantic and requires both to agree to 1e-12 on the same entry streams. The
- * full description (what is learnt, how, the reference, the rules) is that module's docstring;
- * doc/velocity.md has the user's summary.
+ * full specification is that module's docstring; doc/velocity.md has the user's summary.
  *
  * Use:
- *   static double buf[QEI_CAL_BUF_LEN(500)];        2 x 4N doubles: table + one revolution
- *   qei_cal_cfg_t cfg = {tick_s, 32, 500, 1, 8, stall_ticks, 0.06, 2};
+ *   static double buf[QEI_CAL_BUF_LEN(500)];        3 x 4N doubles: table, pass, revolution
+ *   qei_cal_cfg_t cfg = {tick_s, 32, 500, 1, 8, stall_ticks, 1e-3, 0.05, 0.005, 0.15};
  *   qei_cal_init(&st, &cfg, buf, QEI_CAL_BUF_LEN(500));
  *   once per servo period: pop every FIFO entry (until the FIFO is empty) into qei_cal_push(),
- *   then read the TIMEBASE and call qei_cal_read(): r.mt_a (calibrated M/T on A-rising edges)
- *   and r.any (calibrated any-edge), count steps per second.
+ *   then read the TIMEBASE and call qei_cal_read(): r.mt_a (M/T on A-rising edges) and r.any
+ *   (any-edge), count steps per second, calibrated when r.calibrated, else exactly the
+ *   uncalibrated readings.
  *
  * Learning: the time of 4N consecutive edges is one revolution, free of wheel errors; the
- * distance travelled is fitted as a quadratic through three revolution boundaries (constant
- * acceleration: exact on ramps) and each edge's angle in the revolution is read off it; the
- * table is the mean of learn_revs revolutions (learn_revs + 1 whole ones after boundary 0). The
- * reference is the first IDX entry (use_index) or the first entry. LOST: with an index, the
- * phase is unknown until the next IDX (table kept); without one, the table is relearnt. An IDX
- * in another state than before (per direction): re-index, relearn. change_revs consecutive
- * revolutions whose high-passed state extents differ from the table by more than
- * change_threshold counts rms: changed wheel, relearn. Readings: angle between the latest
- * selected edge and the latest one at the previous read (calibrated when the table is learnt
- * and phased) over their time; a reversal or LOST reads 0 and the next selected edge is a
- * reference only; with no new edge min(last, ext / since), ext = the
- * (calibrated) angle to the next selected edge; 0 after stall_ticks.
+ * distance travelled is fitted as a quadratic through the revolution boundaries (constant
+ * acceleration) and each edge's angle in the revolution read off it. A revolution is clean when
+ * its period and the two before fit one constant acceleration within motion_tol; a clean
+ * revolution the table does not explain joins the learning pass if it agrees with the pass's
+ * mean (shape, line and edge figures within shape_tol, line_tol, edge_tol counts rms), else the
+ * pass restarts from it; learn_revs agreeing revolutions become the table. Trust: the table is
+ * used while its phase is known, no IDX disagreement is pending, the latest clean revolution
+ * agreed with it and the A-rising edges' timing is no rougher with it than without it (at every
+ * edge and every eighth of a revolution; a jolt makes it earn that again). IDX: the first sets
+ * boundary 0; one in another place is pending until the next confirms either place (a second
+ * in the new place re-indexes: the count slipped). LOST, or an entry whose A/B state does not
+ * follow the previous one: the phase is unknown until the next IDX (without an index: the
+ * table is relearnt).
  */
 #ifndef ENC_QEI_CALIB_H
 #define ENC_QEI_CALIB_H
@@ -42,7 +44,7 @@ extern "C" {
 #endif
 
 /* doubles the caller provides for N cycles per revolution */
-#define QEI_CAL_BUF_LEN(cycles) ((size_t)8u * (size_t)(cycles))
+#define QEI_CAL_BUF_LEN(cycles) ((size_t)12u * (size_t)(cycles))
 
 typedef struct {
     uint32_t time;  /* TIMEBASE at the step, TS_W bits */
@@ -53,21 +55,37 @@ typedef struct {
 } qei_cal_entry_t;
 
 typedef struct {
-    double   tick_s;           /* seconds per timebase tick */
-    unsigned ts_w;             /* timebase width, 1 .. 32 */
-    uint32_t cycles;           /* N, cycles per revolution (4N states), 1 .. 2^20 */
-    int      use_index;        /* 1: phase the table on IDX entries */
-    uint32_t learn_revs;       /* revolutions averaged, >= 1 */
-    uint64_t stall_ticks;      /* stall timeout in ticks since the last selected edge, 0 = off */
-    double   change_threshold; /* counts rms (high-passed state extents), > 0; 0.06 typical */
-    uint32_t change_revs;      /* consecutive disagreeing revolutions = changed wheel, >= 1 */
+    double   tick_s;     /* seconds per timebase tick */
+    unsigned ts_w;       /* timebase width, 1 .. 32 */
+    uint32_t cycles;     /* N, cycles per revolution (4N states), 2 .. 2^20 */
+    int      use_index;  /* 1: phase the table on IDX entries */
+    uint32_t learn_revs; /* agreeing clean revolutions averaged into a table, >= 1 */
+    uint64_t stall_ticks; /* stall timeout in ticks since the last selected edge, 0 = off */
+    double   motion_tol; /* relative speed mismatch of a clean revolution, > 0; 1e-3 */
+    double   shape_tol;  /* agreement, counts rms, > 0: smooth shape 0.05 */
+    double   line_tol;   /*   cycle-to-cycle at the A edges 0.005 */
+    double   edge_tol;   /*   within the cycles 0.15 */
 } qei_cal_cfg_t;
 
 typedef struct {
-    double mt_a;     /* calibrated M/T on A-rising edges, count steps per second */
-    double any;      /* calibrated any-edge, count steps per second */
+    double mt_a;     /* M/T on A-rising edges, count steps per second */
+    double any;      /* any-edge, count steps per second */
     int calibrated;  /* the table was in use */
 } qei_cal_reading_t;
+
+typedef struct {
+    uint32_t learned;     /* tables learnt with none before */
+    uint32_t changes;     /* tables replaced by a pass that disagreed with them */
+    uint32_t rejected;    /* learning passes restarted (a revolution disagreed with the pass) */
+    uint32_t disagree;    /* clean revolutions that disagreed with the table */
+    uint32_t unclean;     /* revolutions that failed the motion check */
+    uint32_t reindex;     /* re-indexes (an IDX frame confirmed twice) */
+    uint32_t suspect;     /* IDX steps that disagreed with the frame */
+    uint32_t lost;        /* LOST entries */
+    uint32_t missed;      /* entries whose A/B state did not follow the previous one */
+    uint32_t edge_alarms; /* edge check failures */
+    uint32_t jolts;       /* jolts */
+} qei_cal_counts_t;
 
 typedef struct {
     unsigned cpe;
@@ -79,16 +97,20 @@ typedef struct {
 
 typedef struct {
     qei_cal_cfg_t cfg;
-    double *table, *work;
+    double *table, *acc, *work;
     int64_t S;
     uint32_t mask, t_raw;
     uint64_t t;
-    int started, dir, phase_ok, valid, rev_dir;
-    int64_t pos, ref, idx_state[2], rev_next;
-    uint32_t acc_revs, bad;
-    uint64_t rev_t0, t_prev;
-    double last_check;
-    uint32_t n_learned, n_changes, n_reindex, n_lost;
+    int started, dir, ab, framed, phase_ok, a_par, pending, valid, rev_ok, edge_ok, rev_dir;
+    int64_t pos, ref, alt_ref, idx_off[2], idx_cand[2], rev_next;
+    uint32_t cand_n, coarse, ea_k;
+    uint64_t rev_t0, t_prev, t_prev2;
+    int ea_n[2];             /* edge check, [fine, coarse] */
+    int64_t ea_b[2][3];
+    uint64_t ea_t[2][3];
+    double frac[2];
+    double last_shape, last_line, last_edge, last_motion;
+    qei_cal_counts_t n;
     qei_cal_method_t m[2];   /* [0] A rising, [1] any edge */
 } qei_cal_t;
 

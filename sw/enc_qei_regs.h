@@ -123,6 +123,16 @@ extern "C" {
 #define ENC_QEI__CAPS__EFIFO_LOG2_SET(v) ((uint32_t)(((uint32_t)(v) << ENC_QEI__CAPS__EFIFO_LOG2_bp) & ENC_QEI__CAPS__EFIFO_LOG2_bm))
 #define ENC_QEI__CAPS__EFIFO_LOG2_GET(w) ((uint32_t)(((uint32_t)(w) & ENC_QEI__CAPS__EFIFO_LOG2_bm) >> ENC_QEI__CAPS__EFIFO_LOG2_bp))
 #define ENC_QEI__CAPS__EFIFO_LOG2_UPDATE(w, v) ((uint32_t)(((uint32_t)(w) & ~ENC_QEI__CAPS__EFIFO_LOG2_bm) | ENC_QEI__CAPS__EFIFO_LOG2_SET(v)))
+#define ENC_QEI__CAPS__ENGINE_bm 0x80000000u
+#define ENC_QEI__CAPS__ENGINE_bp 31
+#define ENC_QEI__CAPS__ENGINE_bw 1
+#define ENC_QEI__CAPS__ENGINE_SET(v) ((uint32_t)(((uint32_t)(v) << ENC_QEI__CAPS__ENGINE_bp) & ENC_QEI__CAPS__ENGINE_bm))
+#define ENC_QEI__CAPS__ENGINE_GET(w) ((uint32_t)(((uint32_t)(w) & ENC_QEI__CAPS__ENGINE_bm) >> ENC_QEI__CAPS__ENGINE_bp))
+#define ENC_QEI__CAPS__ENGINE_UPDATE(w, v) ((uint32_t)(((uint32_t)(w) & ~ENC_QEI__CAPS__ENGINE_bm) | ENC_QEI__CAPS__ENGINE_SET(v)))
+#define ENC_QEI__CAPS__ENGINE__PER_CHANNEL_VAL 0u
+#define ENC_QEI__CAPS__ENGINE__PER_CHANNEL_bm 0x0u
+#define ENC_QEI__CAPS__ENGINE__SHARED_VAL 1u
+#define ENC_QEI__CAPS__ENGINE__SHARED_bm 0x80000000u
 
 // reg - CTRL (0x08, per channel)
 #define ENC_QEI_CTRL_OFFSET 0x08u

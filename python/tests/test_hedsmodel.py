@@ -132,6 +132,29 @@ def test_cycle_error_from_line_placement():
     assert np.allclose(m.pulse_a_deg, 180, atol=0.1)   # within the local-speed reference
 
 
+def test_the_wheel_repeats_and_the_play_does_not():
+    """Line k and line k + N are the same line: the same placement error, every revolution (and
+    the eccentricity with them), so a typical unit's A edges sit exactly one revolution apart;
+    the shaft's radial and axial play is drawn anew every cycle, so its B edges do not."""
+    seed = 7
+    print(f"seed {seed}")
+    n = note.CPR
+    lines = EncoderUnit(cycle_error_deg=0.7, seed=seed).edges(-3, 2 * n + 3)
+    assert np.std(lines[::4] - np.arange(-3, 2 * n + 3)) > 0.5 / 360     # the errors are there
+    np.testing.assert_allclose(lines[4 * n:] - lines[:-4 * n], n, rtol=0, atol=1e-9)
+    u = EncoderUnit.typical(np.random.default_rng(seed))
+    x = u.edges(-2, 3 * n)
+    a_rise, b_rise = x[0::4], x[1::4]
+    np.testing.assert_allclose(a_rise[n:] - a_rise[:-n], n, rtol=0, atol=1e-9)
+    play = 360 * ((b_rise[n:] - a_rise[n:]) - (b_rise[:-n] - a_rise[:-n]))  # B phase, e°
+    radial, axial = u.q_e * u.radial_play_mm, u.q_ma * u.axial_play_mm
+    want = math.sqrt(2 * (radial ** 2 + axial ** 2) / 3)     # two independent uniform draws
+    print(f"B phase change from one revolution to the next: {np.std(play):.2f} e° rms "
+          f"(independent draws: {want:.2f}), at most {np.max(np.abs(play)):.2f} e°")
+    assert np.std(play) == pytest.approx(want, rel=0.1)
+    assert np.max(np.abs(play)) <= 2 * (radial + axial) + 1e-6
+
+
 def test_ramp_edge_times_are_exact():
     """Constant acceleration from rest: A rises at t = sqrt(2 x / a)."""
     wf = EncoderUnit().waveform(Profile().ramp(0, 600, 0.1))

@@ -23,8 +23,9 @@ from enctools.qei.model import QUAD_FUNCS, QeiModel
 from enctools.regmap import PAGE, addr, enum, get_field, pack, regmap
 from enctools.tb import cocotb_test
 
-# (top, CHANNELS, PROFILE, COUNT_W, TS_W)
-CHANNEL_CONFIGS = (("enc_qei_wb", 3, "full", 32, 32), ("enc_qei_axil", 4, "lean", 32, 32))
+# (top, CHANNELS, PROFILE, COUNT_W, TS_W, ENGINE)
+CHANNEL_CONFIGS = (("enc_qei_wb", 3, "full", 32, 32, 0), ("enc_qei_axil", 4, "lean", 32, 32, 0),
+                   ("enc_qei_wb", 3, "lean", 32, 32, 1))
 SNAP_REGS = ("SNAP_COUNT_LO", "SNAP_COUNT_HI", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA",
              "SNAP_EDGE_DELTA")
 CHAN_REGS = tuple(n for n, r in regmap().items() if r.group == "chan")
@@ -221,6 +222,7 @@ async def global_snapshot(dut):
     for i in range(6):
         await ClockCycles(dut.clk, rng.randint(50, 400))
         await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+        await ClockCycles(dut.clk, envs[0].lag)  # (the shared engine: SNAP_* within its latency)
         snaps = await read_all(envs)
         check_same_instant(snaps, await bus.rd("GSNAP_TIME"), offsets, f"CMD snapshot {i}")
         await take_ready(envs, f"CMD snapshot {i}")
@@ -232,6 +234,7 @@ async def global_snapshot(dut):
     for i in range(4):
         await ClockCycles(dut.clk, rng.randint(20, 300))
         t_in = await pulse_snap_in(dut, rng)
+        await ClockCycles(dut.clk, envs[0].lag)
         gtime = await bus.rd("GSNAP_TIME")
         assert gtime == t_in, f"snap_in snapshot {i}: GSNAP_TIME {gtime:#x}, timebase in the " \
                               f"clock snap_in was first high {t_in:#x}"
@@ -249,6 +252,7 @@ async def global_snapshot(dut):
         await ClockCycles(dut.clk, 100)
         if not await envs[0].bus.rd("EVENTS") & SNAP_READY:
             continue
+        await ClockCycles(dut.clk, envs[0].lag)
         gtime = await bus.rd("GSNAP_TIME")
         await take_ready(envs, f"timer snapshot {len(times)}")
         check_same_instant(await read_all(envs), gtime, offsets, f"timer snapshot {len(times)}")
@@ -292,7 +296,7 @@ async def irq_summary(dut):
         hit = set(rng.sample(range(n), rng.randint(0, n)))
         for k in sorted(hit):
             await envs[k].bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
-        await ClockCycles(dut.clk, 4)
+        await ClockCycles(dut.clk, 4 + envs[0].lag)
         exp = sum(1 << k for k in hit if en[k] & SNAP_READY)
         got = await bus.rd("IRQ_SUMMARY")
         assert got == exp, f"trial {trial}: IRQ_SUMMARY {got:#x}, expected {exp:#x} " \
@@ -301,6 +305,7 @@ async def irq_summary(dut):
         for k in rng.sample(sorted(hit), len(hit) // 2):
             await envs[k].bus.wr("EVENTS", SNAP_READY)
             exp &= ~(1 << k)
+        await ClockCycles(dut.clk, envs[0].lag)
         got = await bus.rd("IRQ_SUMMARY")
         assert got == exp, f"trial {trial}, after clearing: IRQ_SUMMARY {got:#x}, expected {exp:#x}"
     for env in envs:
@@ -398,7 +403,7 @@ async def lanes_probe_compare_per_channel(dut):
             dut.wb_adr_i.value = k * PAGE + regmap()["PRESET_LO"].offset
             dut.wb_cyc_i.value = 1
             dut.wb_stb_i.value = 1
-            for c in range(20):  # ACK / ERR as the master samples them at the next rising edge
+            for c in range(20 + 2 * envs[0].lag):  # ACK / ERR as the master samples them at the next rising edge
                 await Timer(PERIOD_PS // 10, unit="ps")
                 if dut.wb_ack_o.value or dut.wb_err_o.value:
                     break
@@ -415,11 +420,13 @@ async def lanes_probe_compare_per_channel(dut):
         await bus.wr("PRESET_LO", 0)
 
 # ---- pytest --------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,channels,profile,count_w,ts_w", CHANNEL_CONFIGS,
-                         ids=[f"{t}-ch{c}-{p}" for t, c, p, _, _ in CHANNEL_CONFIGS])
-def test_channels(top, channels, profile, count_w, ts_w):
+@pytest.mark.parametrize("top,channels,profile,count_w,ts_w,engine", CHANNEL_CONFIGS,
+                         ids=[f"{t}-ch{c}-{p}" + ("-engine" if e else "")
+                              for t, c, p, _, _, e in CHANNEL_CONFIGS])
+def test_channels(top, channels, profile, count_w, ts_w, engine):
     from enctools.harness import run
 
     code = enum("CAPS", "PROFILE")[profile]
-    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}",
-        parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code})
+    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}_e{engine}",
+        parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code,
+                    "ENGINE": engine})

@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Test driver for sw/enc_qei_calib.c (built by tb/velocity/test_velocity_calibration.py).
- * stdin:  line 1  tick_s ts_w cycles use_index learn_revs stall_ticks change_threshold change_revs
+ * stdin:  line 1  tick_s ts_w cycles use_index learn_revs stall_ticks motion_tol shape_tol
+ *                 line_tol edge_tol
  *         then    "E time a b up lost idx" (an entry) or "R time" (a read)
- * stdout: per read "mt_a any calibrated" (%.17g), at the end
- *         "S learned changes reindex lost acc_revs valid phase_ok last_check". */
+ * stdout: per read "mt_a any calibrated" (%.17g), at the end "S" and the counters (learned
+ *         changes rejected disagree unclean reindex suspect lost missed edge_alarms jolts),
+ *         the flags (valid phase_ok pending rev_ok edge_ok cand_n) and the figures (shape line
+ *         edge motion frac_fine frac_coarse). */
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,9 +20,9 @@ int main(void)
     double *buf;
     unsigned ts_w, ui;
     char kind[2];
-    if (scanf("%lf %u %" SCNu32 " %u %" SCNu32 " %" SCNu64 " %lf %" SCNu32, &cfg.tick_s, &ts_w,
-              &cfg.cycles, &ui, &cfg.learn_revs, &cfg.stall_ticks, &cfg.change_threshold,
-              &cfg.change_revs) != 8) {
+    if (scanf("%lf %u %" SCNu32 " %u %" SCNu32 " %" SCNu64 " %lf %lf %lf %lf", &cfg.tick_s,
+              &ts_w, &cfg.cycles, &ui, &cfg.learn_revs, &cfg.stall_ticks, &cfg.motion_tol,
+              &cfg.shape_tol, &cfg.line_tol, &cfg.edge_tol) != 10) {
         fprintf(stderr, "calib_driver: bad configuration line\n");
         return 2;
     }
@@ -52,9 +55,13 @@ int main(void)
             printf("%.17g %.17g %d\n", r.mt_a, r.any, r.calibrated);
         }
     }
-    printf("S %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %d %d %.17g\n",
-           st.n_learned, st.n_changes, st.n_reindex, st.n_lost, st.acc_revs, st.valid,
-           st.phase_ok, st.last_check);
+    printf("S %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32
+           " %" PRIu32 " %" PRIu32 " %" PRIu32 " %" PRIu32 " %d %d %d %d %d %" PRIu32
+           " %.17g %.17g %.17g %.17g %.17g %.17g\n",
+           st.n.learned, st.n.changes, st.n.rejected, st.n.disagree, st.n.unclean, st.n.reindex,
+           st.n.suspect, st.n.lost, st.n.missed, st.n.edge_alarms, st.n.jolts, st.valid,
+           st.phase_ok, st.pending, st.rev_ok, st.edge_ok, st.cand_n, st.last_shape,
+           st.last_line, st.last_edge, st.last_motion, st.frac[0], st.frac[1]);
     free(buf);
     return 0;
 }

@@ -110,8 +110,9 @@ def test_sim_analysis_on_ideal_registers():
 
 def test_calibrated_rows_quick(tmp_path):
     """The calibrated methods' part of the bench (enctools.velocity.calib), --quick, one
-    non-ideal unit: calibrated M/T A↑ far below the uncalibrated one, the goal lines written."""
-    from enctools.velocity import calib, calib_report
+    non-ideal unit: calibrated M/T A↑ far below the uncalibrated one, the disturbed runs never
+    worse than uncalibrated, the goal lines and tables written."""
+    from enctools.velocity import calib, calib_disturb, calib_report
 
     args = argparse.Namespace(quick=True, seed=5, units=1, jobs=1, stall_ms=200.0, prescale=0,
                               clk_mhz=100.0, rpm_min=1.0, rpm_max=12000.0, points=12)
@@ -126,9 +127,13 @@ def test_calibrated_rows_quick(tmp_path):
     for r in rows:
         assert r["random"]["A cal"] < 5e-4 and r["random"]["A cal"] < r["random"]["A uncal"] / 10
         assert r["none"]["any cal"] < 1e-3 < r["none"]["any uncal"]
-    assert goals[0].startswith("MET") and any("wheel changed" in g for g in goals)
+        assert r["random"]["cal_share"] == 1.0
+    assert len(res["disturbed"]) == len(calib_disturb.QUICK_CASES)
+    assert goals[0].startswith("MET")
+    assert any(g.startswith("MET: never worse, M/T A↑") for g in goals), goals
     text = (tmp_path / "cal.md").read_text()
-    assert "## Error against revolutions of learning" in text and (tmp_path / "cal.png").exists()
+    assert "## Error against revolutions of learning" in text and "## Disturbed runs" in text
+    assert (tmp_path / "cal.png").exists()
 
 
 def test_calibration_table_is_current():

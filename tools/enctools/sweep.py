@@ -156,7 +156,10 @@ def write_table(results: dict, sim: str, seconds: float, path: Path) -> list[str
         "clocks but longer than 1 is still always sampled). Typical units (every factor of the "
         "note's Tables 2 and 3 at its mean) have a soft cliff: only a few of their states are as "
         "narrow as the narrowest, so past the limit a miss is a matter of chance, and the note's "
-        "ΔS (largest deviation either way) is conservative for the narrowest state.",
+        "ΔS (largest deviation either way) is conservative for the narrowest state. A point's "
+        "4000 transitions are two revolutions of the 500-line wheel: the wheel's line errors "
+        "repeat every revolution (each line passes twice, as on a real wheel), the shaft's "
+        "radial and axial play is drawn anew for every cycle.",
         "",
     ]
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -171,7 +174,7 @@ def write_figure(results: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from sweeps import CLK_HZ, MARGIN
+    from enctools.benches.sweeps import CLK_HZ, MARGIN
 
     fls = sorted(results)
     fig, axes = plt.subplots(1, len(fls), figsize=(3.2 * len(fls), 4.2), dpi=120, sharey=True)

@@ -13,15 +13,19 @@ The model works in two steps.
      formula); its radial part adds ``Q_e d cos(θ + ψ)`` to the phase: the note's TIR/2 rule.
    - radial play ``P_r`` and axial play ``P_a``: per cycle the shaft sits at ``u P`` with ``u``
      uniform in [-1, 1], drawn once per cycle, adding ``Q_e u P_r + Q_ma u' P_a`` to the phase;
-     so the largest excursion is P Q, the amount the note budgets. (Play is tied to the cycle, not
-     to time, so re-crossing an edge in a dither finds it in the same place. Its position effect
-     is ignored: Table 1 says play leaves cycle uniformity alone.)
+     so the largest excursion is P Q, the amount the note budgets. Play is random: it is drawn
+     for the absolute cycle number ``k``, so it never repeats from one revolution to the next.
+     (It is tied to the cycle, not to time, so re-crossing an edge in a dither finds it in the
+     same place. Its position effect is ignored: Table 1 says play leaves cycle uniformity
+     alone.)
    - assembly adjustment: a constant phase offset ``phase_error_deg`` (B moves, A stays).
    - pulse width: A's high pulse is ``180 + p_A``, B's ``180 + p_B``, centred. This is where the
      internal error ΔS3 lives: static pulse errors with zero net phase give a state-width error
      of exactly (|p_A| + |p_B|) / 2.
    - cycle error: each cycle's four edges move together by a line-placement error ~ N(0,
-     ``cycle_error_deg``) (code-wheel artwork).
+     ``cycle_error_deg``) (code-wheel artwork). It belongs to the wheel's line ``k mod N``
+     (N = ``cpr``): cycle ``k`` and cycle ``k + N`` are the same line and sit the same distance
+     off, so the wheel's line errors repeat every revolution, as a real wheel's do.
 
 2. **Time.** The profile is split into monotone pieces; each edge it passes is crossed at a time
    found in closed form. Then the comparators' unequal propagation delays (``α ΔT / 360`` s on the
@@ -126,7 +130,17 @@ class EncoderUnit:
     # ------------------------------------------------------------------ space
     def _cycle_noise(self, k: np.ndarray) -> np.ndarray:
         """Per-cycle uniform radial and axial displacements in [-1, 1] and a standard normal line
-        error, shape (len(k), 3); the same cycle always gets the same numbers."""
+        error, shape (len(k), 3). The play (columns 0, 1) is drawn for the absolute cycle ``k``:
+        the same cycle always gets the same numbers, the next revolution new ones. The line error
+        (column 2) is that of the wheel's line ``k mod cpr``: the same every revolution."""
+        k = np.asarray(k, dtype=np.int64)
+        out = self._draws(k)
+        out[:, 2] = self._draws(np.mod(k, self.cpr))[:, 2]
+        return out
+
+    def _draws(self, k: np.ndarray) -> np.ndarray:
+        """The random numbers of cycle number ``k``: three per cycle, in blocks of BLOCK cycles,
+        each block from its own generator seeded with (seed, 2, block)."""
         out = np.empty((len(k), 3))
         block = k // BLOCK
         for b in np.unique(block):

@@ -48,7 +48,8 @@ def render(top=None) -> str:
             "read 0 (checked by enc_qei)" for p in FEATURES]
     out += [f"    parameter integer {p} = -1,  // -1: the field is storage, >= 0: fixed to it "
             "(checked by enc_qei)" for p in fixers]
-    out += ["    parameter integer CHANNELS = 1,  // channel pages (checked by enc_qei)",
+    out += ["    parameter integer CH_PAGES = 1,  // 1: channel pages here; 0: none (the shared engine's)",
+            "    parameter integer CHANNELS = 1,  // channel pages (checked by enc_qei)",
             "    parameter integer ADDR_W   = 8,  // byte address bits, 8 .. 16 (checked by enc_qei)",
             "    parameter integer COUNT_W  = 32, // counter width (checked by enc_qei)",
             "    parameter integer TS_W     = 32  // timebase width (checked by enc_qei)",
@@ -89,7 +90,14 @@ def render(top=None) -> str:
             f"  wire [CHANNELS*{32 * nc}-1:0] f_view_ch;",
             "  wire [CHANNELS*32-1:0] f_stage_ch;",
             "`endif",
-            "  genvar ch;", "  generate", "    for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch"]
+            "  genvar ch;", "  generate", "    if (CH_PAGES == 0) begin : g_no_pages",
+            "      wire unused_pages = &{1'b0, rd_c_q, wr_c_q, bmask, page_hit};",
+            "      assign rd_ch = {CHANNELS*32{1'b0}};",
+            "      assign reg2hw_ch = {CHANNELS*%d{1'b0}};" % c.r2h_w,
+            "`ifdef FORMAL", "      assign f_view_ch = {CHANNELS*%d{1'b0}};" % (32 * nc),
+            "      assign f_stage_ch = {CHANNELS*32{1'b0}};", "`endif",
+            "    end else begin : g_pages",
+            "    for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch"]
     inner = ["      // verilator lint_off UNUSEDSIGNAL",
              f"      wire [{nc - 1}:0] wr_c = wr_c_q & {{{nc}{{page_hit[ch]}}}};  // writes to this page",
              f"      wire [{nc - 1}:0] rd_c = rd_c_q & {{{nc}{{page_hit[ch]}}}};  // reads of this page",
@@ -107,7 +115,7 @@ def render(top=None) -> str:
     inner += ["    " + ln if ln else ln for ln in fc.formal_view("f_view", "rd_c_q")]
     inner[-2:-2] = [f"      assign f_view_ch[ch*{32 * nc} +: {32 * nc}] = f_view;",
                     "      assign f_stage_ch[ch*32 +: 32] = count_hi_stage_q;"]
-    out += inner + ["    end", "  endgenerate", ""]
+    out += inner + ["    end", "    end", "  endgenerate", ""]
     out += ["  // ---- read multiplexer (one select bit at most: AND-OR) and response -----------------",
             "  reg [31:0] rd_d;", "  integer k;", "", "  always @(*) begin", "    rd_d = 32'd0;"]
     out += fg.read_mux("rd_g_q", "rd_d")
@@ -139,7 +147,7 @@ def decode(regs_g, regs_c) -> list[str]:
     out += [f"  assign sel_g_d[{k}] = (page_d == 8'd0) & (off_d == ENC_QEI_{r.inst_name}[7:2]);"
             for k, r in enumerate(regs_g)]
     out += [f"  assign sel_c_d[{k}] = (off_d == ENC_QEI_{r.inst_name}[7:2]);" for k, r in enumerate(regs_c)]
-    out += ["  wire chan_page_d = ({8'd0, page_d} < CHANNELS[15:0]);  // a channel's page",
+    out += ["  wire chan_page_d = (CH_PAGES != 0) & ({8'd0, page_d} < CHANNELS[15:0]);  // a channel's page",
             "",
             "  // verilator lint_off UNUSEDSIGNAL",
             f"  reg [{ng - 1}:0] rd_g_q, wr_g_q;  // a read / write of global register k (read-only ones: unused)",

@@ -6,6 +6,8 @@ Verilog reader of the map (the block, the top, the core, the formal wrappers, th
                            every page; global registers: page 0)
   ENC_QEI_PAGE, ENC_QEI_CHANNELS_MAX   bytes per channel page, pages the map has room for
   ENC_QEI_<REG>_<FIELD>    the field's lsb, and ..._W its width
+  ENC_QEI_<REG>_RESET      the register's reset value as the RDL gives it (every field's reset
+                           at its lsb, 0 where a field has none), before COUNT_W / TS_W masking
   ENC_QEI_<ENUM>_<MEMBER>  an enum member's code, sized to its field (ENUM = the RDL enum type
                            without _e: FUNC, RANGE, INDEX_ACTION, Z_EDGE, PROBE_EDGE, EDGE_TYPE,
                            PROFILE); ENC_QEI_<ENUM>_N the number of members
@@ -52,6 +54,10 @@ def render(top=None) -> str:
         for f in r.fields():
             n = f"ENC_QEI_{r.inst_name}_{f.inst_name}"
             lines.append(f"localparam integer {n} = {f.lsb}, {n}_W = {f.width};")
+    lines += ["", "// Reset values of the whole registers (before COUNT_W / TS_W masking)"]
+    for _, _, r in regs:
+        reset = sum((f.get_property("reset") or 0) << f.lsb for f in r.fields())
+        lines.append(f"localparam [31:0] ENC_QEI_{r.inst_name}_RESET = 32'h{reset:08X};")
     lines += ["", "// Enum codes (RDL enum types), sized to their fields"]
     for name, (width, members) in enum_types().items():
         for m in members:

@@ -28,6 +28,13 @@ from enctools.tb import start
 
 PROFILE_LEAN = enum("CAPS", "PROFILE")["lean"]
 
+
+def engine_lag(channels: int) -> int:
+    """The most clocks the shared engine (ENGINE = 1) takes to show a step in COUNT, an event in
+    EVENTS or a snapshot in SNAP_*: one visit round (12 clocks a channel, at least two channels)
+    plus the visit that writes it (rtl/enc_qei_engine.v)."""
+    return 12 * max(channels, 2) + 24
+
 # ---- configurations and the pytest side -----------------------------------------------------------
 CONFIGS = (("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16))  # (top, COUNT_W, TS_W)
 CONFIG_IDS = tuple(f"{top}-c{count_w}-t{ts_w}" for top, count_w, ts_w in CONFIGS)
@@ -59,9 +66,14 @@ class Env:
         self.pos = 0  # 4X position of the stimulus now
         # the lean profile has no compare unit (and no range modes: its count is free-running)
         self.lean = int(dut.PROFILE.value) == PROFILE_LEAN
+        # the shared engine shows a step in COUNT (and EVENTS, STATUS) up to `lag` clocks later
+        self.engine = int(dut.ENGINE.value) if hasattr(dut, "ENGINE") else 0
+        self.lag = engine_lag(int(dut.CHANNELS.value)) if self.engine else 0
 
     async def settle(self, clocks: int = 12):
-        await ClockCycles(self.dut.clk, clocks)
+        """Wait `clocks`, and with the shared engine also its latency (so that COUNT, EVENTS and
+        STATUS show what happened before)."""
+        await ClockCycles(self.dut.clk, clocks + self.lag)
 
     async def setup(self, model: QeiModel, func="x4", rng_mode="free", filter_len=FILTER,
                     count=0, ceiling=None, compare=None, en=1):

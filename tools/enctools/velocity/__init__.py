@@ -35,8 +35,9 @@ Modules: config (fixed choices), cli (options, main), plan (speeds, units, jobs,
 cases), model (the model layer), simulate (the simulated layer through enctools.harness),
 analyse (one simulated case against the model), sim_table and report (the table), goals (the
 verdicts), format (number formats), figure (the plot), calib (the calibrated methods of
-hedsmodel.calibration on ideal edge-FIFO entries, pure Python; ``--calib on|off|only``) and
-calib_report (doc/results/velocity_calibration.md and its PNG).
+hedsmodel.calibration on ideal edge-FIFO entries, pure Python; ``--calib on|off|only``),
+calib_disturb (its disturbed runs and their one-second windows) and calib_report
+(doc/results/velocity_calibration.md and its PNG).
 """
 
 from .analyse import analyse_case

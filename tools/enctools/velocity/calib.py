@@ -5,14 +5,14 @@ units, pure Python: the entries an ideal enc_qei edge FIFO pushes
 bench) and reads at 1 kHz, through the calibrating estimator and through the same estimator with
 calibration off (uncalibrated M/T on A-rising edges and on any edge, the same rules).
 
-The units are the bench's, with their code-wheel line errors repeating every revolution
-(hedsmodel.calibration.repeating_wheel: the model draws them per cycle number). Their per-cycle
-radial and axial play is the model's, random every cycle and never repeating ("random": the
-note's random phase error, which no calibration can learn); the any-edge figures are also given
-with that play repeating every revolution ("repeating") and without play ("none")."""
+The units are the bench's: their code-wheel line errors repeat every revolution, their radial
+and axial play is random, new every cycle (the note's random phase error, which no calibration
+can learn); the any-edge figures are also given without play ("none"). Jobs: constant speeds,
+the learning curve, the 6 rpm latency, and the disturbed runs of calib_disturb."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -20,17 +20,22 @@ from concurrent.futures import ProcessPoolExecutor
 from .config import CPR, DETUNE, GOAL_BAND, READ_HZ
 
 LEARN_REVS = 8
-CHANGE_THRESHOLD = 0.06
 LATENCY_RPM, LATENCY_STEP = 6.0, 1.1       # 6 rpm, steps of +-10 %
-LEARN_RPM = 300.0                           # where the scenarios learn first
+
+
+def _played(unit, play: str):
+    """The unit as it is ("random" play) or without radial and axial play ("none")."""
+    if play not in ("random", "none"):
+        raise ValueError(f"play must be random or none, not {play!r}")
+    return unit if play == "random" else dataclasses.replace(unit, radial_play_mm=0.0,
+                                                             axial_play_mm=0.0)
 
 
 def _cfg(tb, stall_s, use_index=True, learn_revs=LEARN_REVS):
     from hedsmodel.calibration import CalibConfig
 
     return CalibConfig(tick_s=tb.tick_s, ts_w=tb.ts_w, cycles=CPR, use_index=use_index,
-                       learn_revs=learn_revs, stall_ticks=int(round(stall_s / tb.tick_s)),
-                       change_threshold=CHANGE_THRESHOLD)
+                       learn_revs=learn_revs, stall_ticks=int(round(stall_s / tb.tick_s)))
 
 
 def _profile(spec):
@@ -47,7 +52,7 @@ def _readings(wf, tb, t0, t_end, cfgs):
     import numpy as np
 
     from hedsmodel.calibration import CalibratingEstimator, run_stream, stream_ops
-    from hedsmodel.velocity import edge_entries_with_ticks, to_rpm
+    from hedsmodel.velocity import edge_entries_with_ticks
 
     ents, ticks = edge_entries_with_ticks(wf, tb)
     tr = np.arange(t0, t_end, 1.0 / READ_HZ)
@@ -58,7 +63,6 @@ def _readings(wf, tb, t0, t_end, cfgs):
         est = CalibratingEstimator(cfg)
         a, n, cal = run_stream(est, stream_ops(ents, ticks, rt, (1 << tb.ts_w) - 1))
         out.append((tr, np.array(a) * k, np.array(n) * k, np.array(cal), est))
-    del to_rpm
     return out
 
 
@@ -72,10 +76,10 @@ def _rms(x, true, sel):
 
 def run_constant(job) -> dict:
     """One unit at one constant speed: learn, then score calibrated and uncalibrated readings
-    over the same window (after the table is learnt)."""
+    over the same window after the table is learnt (every read: a read the estimator does not
+    trust the table for is its uncalibrated reading)."""
     import numpy as np
 
-    from hedsmodel.calibration import repeating_wheel
     from hedsmodel.velocity import true_rpm
 
     t_start = time.perf_counter()
@@ -83,11 +87,11 @@ def run_constant(job) -> dict:
     rev = 60.0 / rpm
     learn = job.get("learn_revs", LEARN_REVS)
     t_meas = max(2 * rev, job["meas_s"])
-    dur = (learn + 2.2) * rev + t_meas
+    dur = (learn + 3.2) * rev + t_meas
     prof = _profile([("constant", rpm * DETUNE, dur)])
     res = {"rpm": rpm, "unit": job["unit_name"], "learn_revs": learn}
     for play in job["plays"]:
-        wf = repeating_wheel(job["unit"], play).waveform(prof, index=True)
+        wf = _played(job["unit"], play).waveform(prof, index=True)
         cfgs = [_cfg(tb, stall_s, learn_revs=learn), _cfg(tb, stall_s, learn_revs=10**9)]
         if play == "random" and job.get("no_index"):
             cfgs.append(_cfg(tb, stall_s, use_index=False, learn_revs=learn))
@@ -95,16 +99,15 @@ def run_constant(job) -> dict:
         tr, true = runs[0][0], true_rpm(prof, runs[0][0])
         cal = runs[0][3]
         t_cal = float(tr[np.argmax(cal)]) if cal.any() else math.nan
-        sel = (tr >= dur - t_meas) & cal
+        sel = tr >= dur - t_meas
         r = {"revs_to_cal": t_cal / rev, "n": int(sel.sum()),
+             "cal_share": float(np.mean(cal[sel])),
              "A cal": _rms(runs[0][1], true, sel), "any cal": _rms(runs[0][2], true, sel),
              "A uncal": _rms(runs[1][1], true, sel), "any uncal": _rms(runs[1][2], true, sel),
-             "A cal max": float(np.max(np.abs(runs[0][1][sel] / true[sel] - 1)))
-             if sel.any() else math.nan}
+             "A cal max": float(np.max(np.abs(runs[0][1][sel] / true[sel] - 1)))}
         if len(runs) > 2:
-            sel_n = (tr >= dur - t_meas) & runs[2][3]
-            r["A noidx"] = _rms(runs[2][1], true, sel_n)
-            r["any noidx"] = _rms(runs[2][2], true, sel_n)
+            r["A noidx"] = _rms(runs[2][1], true, sel)
+            r["any noidx"] = _rms(runs[2][2], true, sel)
             r["revs_to_cal noidx"] = float(tr[np.argmax(runs[2][3])]) / rev \
                 if runs[2][3].any() else math.nan
         res[play] = r
@@ -117,20 +120,19 @@ def run_latency(job) -> dict:
     the time until the readings are within 1 % of the new speed and stay there."""
     import numpy as np
 
-    from hedsmodel.calibration import repeating_wheel
     from hedsmodel.velocity import true_rpm
 
     tb, stall_s = job["tb"], job["stall_s"]
     v0, v1, hold, n_steps = LATENCY_RPM, LATENCY_RPM * LATENCY_STEP, job["hold_s"], job["steps"]
-    spec = [("constant", 60.0 * DETUNE, (LEARN_REVS + 2.2) * 1.0),
+    spec = [("constant", 60.0 * DETUNE, (LEARN_REVS + 4.2) * 1.0),
             ("ramp", 60.0 * DETUNE, v0 * DETUNE, 1.0), ("constant", v0 * DETUNE, 1.0)]
     for i in range(n_steps):
         spec.append(("constant", (v1 if i % 2 == 0 else v0) * DETUNE, hold))
     prof = _profile(spec)
-    t_first = (LEARN_REVS + 2.2) + 2.0
+    t_first = (LEARN_REVS + 4.2) + 2.0
     out = {"unit": job["unit_name"]}
     for play in job["plays"]:
-        wf = repeating_wheel(job["unit"], play).waveform(prof, index=True)
+        wf = _played(job["unit"], play).waveform(prof, index=True)
         runs = _readings(wf, tb, job["t0"], prof.duration_s,
                          [_cfg(tb, stall_s), _cfg(tb, stall_s, learn_revs=10**9)])
         tr = runs[0][0]
@@ -161,67 +163,20 @@ def run_learning(job) -> dict:
     return {"unit": job["unit_name"], "rpm": job["rpm"], "by_k": res}
 
 
-def run_swap(job) -> dict:
-    """Learn unit 1 at ``rpm``, swap to unit 2 (another seed) at the same shaft angle: flagged?
-    relearnt after how many revolutions? errors before, in between and after."""
-    import dataclasses
+def run_disturbed(job) -> dict:
+    """One disturbed run (calib_disturb.CASES) on one unit."""
+    from .calib_disturb import run_case
 
-    import numpy as np
-
-    from hedsmodel import Profile
-    from hedsmodel.calibration import (CalibratingEstimator, repeating_wheel, run_stream,
-                                       stream_ops)
-    from hedsmodel.velocity import edge_entries_with_ticks
-
-    tb, rpm = job["tb"], job["rpm"]
-    rev = 60.0 / rpm
-    t1, t2 = (LEARN_REVS + 6.2) * rev, (LEARN_REVS + 10.2) * rev
-    p1 = Profile().constant(rpm * DETUNE, t1)
-    u1, u2 = (repeating_wheel(u, "random") for u in (job["unit"], job["unit2"]))
-    e1, k1 = edge_entries_with_ticks(u1.waveform(p1, index=True), tb)
-    p2 = Profile(start_deg=p1.end_deg).constant(rpm * DETUNE, t2)
-    tb2 = dataclasses.replace(tb, tb_offset=tb.tb_offset + int(round(t1 * tb.clk_hz)))
-    e2, k2 = edge_entries_with_ticks(u2.waveform(p2, index=True), tb2)
-    tr = np.arange(job["t0"], t1 + t2, 1.0 / READ_HZ)
-    rt = tb.ticks(tb.clock_of(tr))
-    est = CalibratingEstimator(_cfg(tb, job["stall_s"]))
-    events, states = [], []
-    ops = stream_ops(e1 + e2, np.concatenate([k1, k2]), rt, (1 << tb.ts_w) - 1)
-    a, n, cal = [], [], []
-    prev = (0, 0)
-    for kind, x in ops:
-        if kind == "E":
-            est.push(x)
-            continue
-        r = est.read(x)
-        a.append(r.mt_a * 60 / (4 * CPR))
-        n.append(r.any * 60 / (4 * CPR))
-        cal.append(r.calibrated)
-        now = (est.n_changes, est.n_reindex)
-        if now != prev:
-            events.append((len(a) - 1, "changed wheel" if now[0] > prev[0] else "re-index"))
-            prev = now
-        states.append(est.last_check)
-    a, cal = np.array(a), np.array(cal)
-    true = rpm * DETUNE
-    flagged = [(float(tr[i] - t1) / rev, why) for i, why in events if tr[i] > t1]
-    back = np.flatnonzero(cal & (tr > t1) & (tr > (t1 + flagged[0][0] * rev if flagged else 0)))
-    relearnt = float(tr[back[0]] - t1) / rev if flagged and back.size else math.nan
-    before = (tr > t1 - 4 * rev) & (tr < t1) & cal
-    between = (tr > t1) & cal & (tr < (t1 + flagged[0][0] * rev if flagged else t1 + t2))
-    after = (tr > t1 + (relearnt + 0.5) * rev) & cal if not math.isnan(relearnt) else cal & False
-    e = lambda s: float(np.sqrt(np.mean((a[s] / true - 1) ** 2))) if s.any() else math.nan
-    return {"unit": job["unit_name"], "unit2": job["unit2_name"], "rpm": rpm,
-            "flagged_revs": flagged[0][0] if flagged else math.nan,
-            "why": flagged[0][1] if flagged else "not flagged", "relearnt_revs": relearnt,
-            "err_before": e(before), "err_between": e(between), "err_after": e(after)}
+    t_start = time.perf_counter()
+    r = run_case({**job, "cfg": _cfg(job["tb"], job["stall_s"])})
+    r["wall_s"] = time.perf_counter() - t_start
+    return r
 
 
 def plan(args, units, rng):
-    """The jobs: constant speeds (30 .. 12,000 rpm), learning curves, 6 rpm latency, wheel
-    swaps. ``--quick``: fewer of each."""
-    import dataclasses
-
+    """The jobs: constant speeds (30 .. 12,000 rpm), learning curves, 6 rpm latency, disturbed
+    runs (every case on every non-ideal unit). ``--quick``: fewer of each."""
+    from .calib_disturb import CASES, QUICK_CASES
     from .plan import random_phase, speeds, timebase
 
     tb = timebase(args)
@@ -230,40 +185,52 @@ def plan(args, units, rng):
     if args.quick:
         rpms = [r for r in rpms if r in (rpms[0], rpms[len(rpms) // 2], rpms[-1])]
     real = [(n, u) for n, u in units if n != "ideal"] or units
+    few = real[:1] if args.quick else real
     base = lambda: {"tb": random_phase(tb, rng), "t0": float(rng.uniform(0, 1 / READ_HZ)),
                     "stall_s": stall}
+    meas = 0.05 if args.quick else 0.3
     jobs = []
     for rpm in rpms:
         for name, unit in units:
             jobs.append(("constant", {**base(), "rpm": rpm, "unit_name": name, "unit": unit,
-                                      "meas_s": 0.05 if args.quick else 0.3,
-                                      "plays": ("random", "repeating", "none"),
+                                      "meas_s": meas, "plays": ("random", "none"),
                                       "no_index": True}))
     ks = (0, 1, 2, 4, 8) if args.quick else tuple(range(0, 11)) + (14,)
     for rpm in ((394.0,) if args.quick else (30.0, 2180.0)):
-        for name, unit in real[:1 if args.quick else len(real)]:
+        for name, unit in few:
             jobs.append(("learning", {**base(), "rpm": rpm, "unit_name": name, "unit": unit,
-                                      "meas_s": 0.05 if args.quick else 0.3, "ks": ks,
-                                      "plays": ("random", "none")}))
-    for name, unit in real[:1 if args.quick else len(real)]:
+                                      "meas_s": meas, "ks": ks, "plays": ("random", "none")}))
+    for name, unit in few:
         jobs.append(("latency", {**base(), "unit_name": name, "unit": unit,
                                  "hold_s": 0.3, "steps": 4 if args.quick else 12,
-                                 "plays": ("random", "repeating")}))
-    from hedsmodel import EncoderUnit
-
-    for i, (name, unit) in enumerate(real[:1 if args.quick else 2]):
-        other = EncoderUnit.typical(rng) if i % 2 == 0 else EncoderUnit.draw(rng)
-        for rpm in ((600.0,) if args.quick else (600.0, 3000.0)):
-            jobs.append(("swap", {**base(), "rpm": rpm, "unit_name": name, "unit": unit,
-                                  "unit2_name": "another " + ("typical" if i % 2 == 0
-                                                               else "drawn") + " unit",
-                                  "unit2": other}))
-    del dataclasses
+                                 "plays": ("random", "none")}))
+    for case in (QUICK_CASES if args.quick else tuple(CASES)):
+        for name, unit in few:
+            jobs.append(("disturbed", {**base(), "case": case, "unit_name": name, "unit": unit,
+                                       "seed": int(rng.integers(2**31))}))
     return jobs
 
 
 RUNNERS = {"constant": run_constant, "learning": run_learning, "latency": run_latency,
-           "swap": run_swap}
+           "disturbed": run_disturbed}
+
+
+def _line(kind, r) -> str:
+    """The progress line of a finished job."""
+    if kind == "constant":
+        rr = r["random"]
+        return (f"calibrated {r['unit']} {r['rpm']:g} rpm: M/T A↑ {100 * rr['A cal']:.4f} % "
+                f"(uncalibrated {100 * rr['A uncal']:.3f} %), any edge {100 * rr['any cal']:.3f} % "
+                f"(uncalibrated {100 * rr['any uncal']:.1f} %), learnt after "
+                f"{rr['revs_to_cal']:.1f} rev, table in use {100 * rr['cal_share']:.0f} %")
+    if kind == "disturbed":
+        a, n = r["A"], r["any"]
+        return (f"disturbed {r['unit']}, {r['what']}: worst 1 s window from {a['worst_at_s']:.1f} s"
+                f", M/T A↑ calibrated {100 * a['worst_cal']:.4f} % / uncalibrated "
+                f"{100 * a['worst_uncal']:.4f} % = {a['worst_ratio']:.3f}; any edge "
+                f"{n['worst_ratio']:.3f}; last second {100 * a['end_cal']:.4f} % / "
+                f"{100 * a['end_uncal']:.4f} %")
+    return f"calibrated {kind} {r['unit']}: done"
 
 
 def run_calibration(args, units):
@@ -276,16 +243,9 @@ def run_calibration(args, units):
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.jobs) as ex:
         futs = [(kind, ex.submit(RUNNERS[kind], j)) for kind, j in jobs]
-        for kind, f in futs:
+        for i, (kind, f) in enumerate(futs):
             r = f.result()
             out[kind].append(r)
-            if kind == "constant":
-                rr = r["random"]
-                print(f"calibrated {r['unit']} {r['rpm']:g} rpm: M/T A↑ {100 * rr['A cal']:.4f} % "
-                      f"(uncalibrated {100 * rr['A uncal']:.3f} %), any edge "
-                      f"{100 * rr['any cal']:.3f} % (uncalibrated {100 * rr['any uncal']:.1f} %)"
-                      f", learnt after {rr['revs_to_cal']:.1f} rev", flush=True)
-            else:
-                print(f"calibrated {kind} {r['unit']}: done", flush=True)
+            print(f"[{i + 1}/{len(futs)}] {_line(kind, r)}", flush=True)
     out["wall_s"] = time.perf_counter() - t0
     return out

@@ -49,7 +49,9 @@ def _units(units, usum) -> list:
         s = usum[n]
         L.append(f"| {n} | {s['state_error_deg']:.1f} | {s['phase_error_deg']:.1f} | "
                  f"{s['pulse_error_deg']:.1f} | {s['cycle_error_deg']:.2f} | {s['ecc_mm']:.4f} |")
-    L.append("")
+    L += ["", "Each unit's code-wheel line errors repeat every revolution (line k and line k + 500 "
+          "are the same line), as its eccentricity does; its radial and axial shaft play is "
+          "drawn anew for every cycle.", ""]
     return L
 
 
