@@ -14,9 +14,9 @@
  * full and lean profiles): in a counting build they return ENC_QEI_DRV_ENOTSUP.
  *
  * Writes are not assumed visible to the next read. A build whose channels share one engine
- * (CAPS bit 31, ENGINE = shared) shows a write's effect, a snapshot and a count step up to a
- * bounded number of clocks late (the register reference gives the bound); only the snapshot
- * registers are exact. So the driver
+ * (CAPS.ENGINE = shared) may show a write's effect, a snapshot and a count step up to a bounded
+ * number of clocks late (the register descriptions give the bounds); only the snapshot registers
+ * are exact. So the driver
  *   - reads SNAP_* only after that channel's EVENTS.SNAP_READY reads 1 (the hardware raises it
  *     once SNAP_* hold the new snapshot), never straight after a SNAP_CTRL.CMD or
  *     GSNAP_CTRL.CMD write;

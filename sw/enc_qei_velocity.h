@@ -114,7 +114,7 @@ double qei_vel_rpm(double counts_per_s, unsigned counts_per_rev);
  * STATUS right after (those three are live values, not latched with the snapshot). count_w is
  * CAPS.COUNT_W. It reads the snapshot straight after the command, so it needs the command to
  * act before the next read: true of the per-channel build on a bus that does not post writes,
- * not of a shared-engine build (CAPS bit 31), which shows a snapshot some clocks later. Firmware
+ * not necessarily of a shared-engine build (CAPS.ENGINE), which may show it later. Firmware
  * for every build uses enc_qei_drv_snap_take() of sw/enc_qei_drv.h, which waits for
  * EVENTS.SNAP_READY.
  */

@@ -26,9 +26,11 @@
  *    the bus does with it), prints DONE and ends the simulation.
  *
  * Lines of the output (tools/enctools/litex/check.py parses them):
- *   BUILD <channels> <profile> <count_w> <ts_w> <clock_hz> <period_ticks> <efifo_log2> <vel>
- *        vel: "double" (velocities printed to 0.001 count/s) or "fx<F>" (the fixed-point reading
- *        printed exactly: F decimals)
+ *   BUILD <channels> <profile> <count_w> <ts_w> <clock_hz> <period_ticks> <efifo_log2> <engine>
+ *         <vel>
+ *        engine: CAPS.ENGINE (1: the channels share one engine); vel: "double" (velocities
+ *        printed to 0.001 count/s) or "fx<F>" (the fixed-point reading printed exactly: F
+ *        decimals)
  *   S <n> <gsnap_time> <latency> <cycles> | <pos_k> <vel_k> | ...
  *        one per snapshot: GSNAP_TIME, TIMEBASE at the handler's entry minus GSNAP_TIME (the
  *        interrupt latency: trap entry and LiteX's dispatch, in clocks), the handler's cycles,
@@ -440,9 +442,9 @@ int main(void)
 #else
         const char *vel = "fx";
 #endif
-        printf("BUILD %u %u %u %u %lu %lu %u %s", dev.channels, dev.profile, dev.count_w,
+        printf("BUILD %u %u %u %u %lu %lu %u %lu %s", dev.channels, dev.profile, dev.count_w,
                dev.ts_w, (unsigned long)CONFIG_CLOCK_FREQUENCY, (unsigned long)period_ticks,
-               dev.efifo_log2, vel);
+               dev.efifo_log2, (unsigned long)ENC_QEI__CAPS__ENGINE_GET(dev.caps), vel);
 #ifndef ENC_FW_VEL_double
         printf("%u", ENC_FW_FRAC);
 #endif

@@ -7,7 +7,7 @@
  * The model's clock advances one tick per bus access. A write takes effect LATENCY accesses
  * after it (0: before the next access, as in today's build); a snapshot taken at tick T shows in
  * channel k STAGGER * k + LATENCY accesses later: that channel's SNAP_* registers change to the
- * values of tick T and its EVENTS.SNAP_READY rises together (a shared-engine build: CAPS bit 31).
+ * values of tick T and its EVENTS.SNAP_READY rises together (what CAPS.ENGINE = shared allows).
  * Until then SNAP_* hold the previous snapshot, so a driver that reads them early reads old
  * values. EVENTS is write-1-to-clear; IRQ_SUMMARY follows EVENTS & IRQ_EN; COUNT_LO latches
  * COUNT_HI; GSNAP_TIME changes when the last channel shows the snapshot. The count of channel k

@@ -11,8 +11,10 @@ linked) and with the double one (FW_VEL=double). The firmware built with FW_FAUL
 register from the wrong channel page, and the same check must fail on it. The edge-FIFO build
 (simsoc.EFIFO: 3 channels, 256 entries each) runs the same firmware, which drains the FIFOs;
 check.check_efifo compares the entries with the model's steps, and must fail on the firmware
-built with FW_FAULT=efifo (an entry's direction from the wrong bit). Both builds read one
-unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and reads all ones.
+built with FW_FAULT=efifo (an entry's direction from the wrong bit). A third build (simsoc.ENGINE:
+the lean profile, the channels sharing one engine) runs the same firmware. The main and the
+edge-FIFO builds read one unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and
+reads all ones.
 
 Run by `make soc-sim` (ENC_SOC_SIM=1), after scripts/soc_sim.py has built the simulator; the
 builds and runs are cached, so this reuses them. Skipped by `make test`.
@@ -57,7 +59,7 @@ def test_firmware_finds_the_build(good):
     assert run.done, "the firmware did not print DONE"
     assert run.build == {"channels": CFG.channels, "profile": 2, "count_w": 32, "ts_w": 32,
                          "clk_hz": CFG.clk_hz, "period": CFG.clk_hz // 1000, "efifo_log2": 0,
-                         "vel": "fx8"}
+                         "engine": 0, "vel": "fx8"}
     assert len(run.rows) == CFG.snapshots
 
 
@@ -174,6 +176,14 @@ def test_wrong_efifo_field_fails_the_check():
     run, res, fifo = _run("efifo", ECFG)
     assert run.done
     assert not fifo.ok and [m for w, m in fifo.failures if w == "efifo"], fifo.failures
+
+
+def test_shared_engine_build():
+    """The same firmware on the lean profile with the channels sharing one engine (CAPS.ENGINE =
+    shared): the driver's snapshots, positions and velocities pass every check there too."""
+    run, res, _ = _run(cfg=simsoc.ENGINE)
+    assert run.build["engine"] == 1 and run.build["profile"] == 3
+    assert res.ok, res.failures
 
 
 @pytest.mark.parametrize("which", ["main", "efifo"])

@@ -77,10 +77,10 @@ def parse(console: str) -> Run:
         f = line.split()
         if not f:
             continue
-        if f[0] == "BUILD" and len(f) == 9:
+        if f[0] == "BUILD" and len(f) == 10:
             r.build = dict(zip(("channels", "profile", "count_w", "ts_w", "clk_hz", "period",
-                                "efifo_log2"), map(int, f[1:8])))
-            r.build["vel"] = f[8]                 # "double" or "fx<F>"
+                                "efifo_log2", "engine"), map(int, f[1:9])))
+            r.build["vel"] = f[9]                 # "double" or "fx<F>"
         elif f[0] == "S":
             v = [x for x in f[1:] if x != "|"]
             n, t, lat, cyc = (int(x) for x in v[:4])

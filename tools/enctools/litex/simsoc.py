@@ -51,11 +51,14 @@ class SocConfig:
     snapshots: int = 100         # global snapshots the firmware records (one per ms)
     opt_level: str = "O3"        # C++ optimisation of the Verilated model
     efifo_log2: int = 0          # the edge FIFO of every channel: 2^efifo_log2 entries, 0 none
+    engine: int = 0              # 1: the channels share one engine (lean profile only)
     motion_names: tuple = ()     # the channels' motions by name (motion.profiles); () all four
 
     @property
     def tag(self) -> str:
-        return f"ch{self.channels}_{self.profile}" + (f"_efifo{self.efifo_log2}" if self.efifo_log2 else "")
+        return (f"ch{self.channels}_{self.profile}"
+                + (f"_efifo{self.efifo_log2}" if self.efifo_log2 else "")
+                + ("_engine" if self.engine else ""))
 
     @property
     def out(self) -> Path:
@@ -74,6 +77,7 @@ class SocConfig:
 # second, which no firmware on this CPU could drain: doc/litex.md)
 MAIN = SocConfig()
 EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
+ENGINE = SocConfig(profile="lean", engine=1)
 
 
 def _log(msg: str) -> None:
@@ -113,7 +117,7 @@ def make_soc(cfg: SocConfig):
                 integrated_sram_size=SRAM_SIZE, uart_name="sim")
             self.motion = motion.MotionGen(cfg.motions()).module()
             add_enc_qei(self, name="enc_qei", pads=self.motion, channels=cfg.channels,
-                        profile=cfg.profile, efifo_log2=cfg.efifo_log2)
+                        profile=cfg.profile, efifo_log2=cfg.efifo_log2, engine=cfg.engine)
             self.sim_finish = SimFinish()
 
     return EncSimSoC()
