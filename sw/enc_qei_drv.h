@@ -42,6 +42,9 @@
  * Register access goes through ENC_QEI_DRV_RD(reg) and ENC_QEI_DRV_WR(reg, value) (default: a
  * volatile access). Define them when compiling enc_qei_drv.c to add bus barriers or to run the
  * driver against a model (tb/enc_qei_doc/drv_model.c does).
+ *
+ * Tested by tb/enc_qei_doc/test_c_driver.py against a register model that lands writes and
+ * snapshots late, and by make soc-sim on the RTL of a per-channel and of a shared-engine build.
  */
 #ifndef ENC_QEI_DRV_H
 #define ENC_QEI_DRV_H
