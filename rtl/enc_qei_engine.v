@@ -1111,7 +1111,8 @@ module enc_qei_engine #(
     end
   end
 
-  // slot i writes word i of this order (slots 0 .. 19)
+  // slot i writes word i of this order (slots 0 .. 19; the configuration words first: with two
+  // channels visited the next push reads them in slots 1 .. 9)
   always @(*) begin
     wmask = {64{1'b1}};
     case (slot_q)
@@ -1125,16 +1126,17 @@ module enc_qei_engine #(
       5'd7:  begin waddr = {cw_q, W_TMO};    wdata = n_tmo_q;    end
       5'd8:  begin waddr = {cw_q, W_HI};     wdata = n_hi_q;     end
       5'd9:  begin waddr = {cw_q, W_MOT};    wdata = n_mot_q;    end
-      5'd10: begin waddr = {cw_q, W_EVT};    wdata = n_evt_q;    end
-      5'd11: begin waddr = {cw_q, W_EDGE};   wdata = n_edge_q;   end
-      5'd12: begin waddr = {cw_q, W_SBASE};  wdata = n_sbase_q;  end
-      5'd13: begin waddr = {cw_q, W_SCNT};   wdata = n_scnt_q;   wmask = {64{n_snap_q}}; end
-      5'd14: begin waddr = {cw_q, W_STIME};  wdata = n_stime_q;  wmask = {64{n_snap_q}}; end
-      5'd15: begin waddr = {cw_q, W_SDELTA}; wdata = n_sdelta_q; wmask = {64{n_snap_q}}; end
-      5'd16: begin waddr = {cw_q, W_ILATCH}; wdata = n_ilatch_q; wmask = {64{n_latch_q}}; end
-      5'd17: begin waddr = {cw_q, W_PLATCH}; wdata = n_platch_q; wmask = {64{n_probe_q}}; end
-      5'd18: begin waddr = {cw_q, W_PTIME};  wdata = n_ptime_q;  wmask = ptime_mask_q; end
-      default: begin waddr = {cw_q, W_STL};  wdata = n_stl_q;    end
+      5'd10: begin waddr = {cw_q, W_EDGE};   wdata = n_edge_q;   end
+      5'd11: begin waddr = {cw_q, W_SBASE};  wdata = n_sbase_q;  end
+      5'd12: begin waddr = {cw_q, W_SCNT};   wdata = n_scnt_q;   wmask = {64{n_snap_q}}; end
+      5'd13: begin waddr = {cw_q, W_STIME};  wdata = n_stime_q;  wmask = {64{n_snap_q}}; end
+      5'd14: begin waddr = {cw_q, W_SDELTA}; wdata = n_sdelta_q; wmask = {64{n_snap_q}}; end
+      5'd15: begin waddr = {cw_q, W_ILATCH}; wdata = n_ilatch_q; wmask = {64{n_latch_q}}; end
+      5'd16: begin waddr = {cw_q, W_PLATCH}; wdata = n_platch_q; wmask = {64{n_probe_q}}; end
+      5'd17: begin waddr = {cw_q, W_PTIME};  wdata = n_ptime_q;  wmask = ptime_mask_q; end
+      5'd18: begin waddr = {cw_q, W_STL};    wdata = n_stl_q;    end
+      default: begin waddr = {cw_q, W_EVT}; wdata = n_evt_q;   end  // (last: an event shows
+      // in EVENTS, and on irq, only when the values it announces are readable)
     endcase
   end
 
@@ -1162,7 +1164,7 @@ module enc_qei_engine #(
   end
 
   // when the writes are done (slot 19): the channel's first visit done, its write applied (reads
-  // of it go on); its irq (slot 0)
+  // of it go on), its irq
   reg [CHANNELS-1:0] irq_q;
   reg                w_taken_q;  // the write of cw_q was applied
 
@@ -1180,7 +1182,7 @@ module enc_qei_engine #(
       if (wr_on_q && slot_q == 5'd19) begin
         fresh_q <= fresh_q & ~onehot(cw_q);
       end
-      if (wr_on_q && slot_q == 5'd0) begin
+      if (wr_on_q && slot_q == 5'd19) begin
         irq_q <= (irq_q & ~onehot(cw_q)) | (onehot(cw_q) & {CHANNELS{n_irq_q}});
       end
     end
