@@ -26,10 +26,13 @@
 //
 // The bus (the channel pages; the global registers are enc_qei_regs'): a read reads the state
 // memory's second port at once (the value as of the channel's last visit); a write is put in
-// the channel's write slot (enc_qei_ram `u_pend`, one per channel) and answered at once; the
-// engine takes it at the channel's next push and writes its results at the visit after. A
-// second write to a channel, or a read of a channel, waits while a write of that channel waits
-// or is being applied, so the bus sees its own writes in order. COUNT_LO read with COUNT_W > 32:
+// the channel's write slot (enc_qei_ram `u_pend`, one per channel) and answered at once. The
+// engine takes a write of a register the lane uses at the channel's next push (it acts from the
+// read after it) and writes its results at the visit after; a state write (EVENTS, QERR_COUNT,
+// GLITCH_COUNT, IRQ_EN, COUNT_HI) at the channel's next visit, which applies it to the values a
+// read showed (not to the window's new events). A second write to a channel, or a read of a
+// channel, waits while a write of that channel waits or is being applied, so the bus sees its
+// own writes in order. The bounds in clocks: rtl/enc_qei.rdl, CAPS.ENGINE = shared. COUNT_LO read with COUNT_W > 32:
 // the high word goes to a latch (one, kept for the last channel read; the one before goes to its
 // channel's memory through that channel's write slot), which COUNT_HI reads.
 // After rst every channel's words are the registers' reset values: the first visit of each
@@ -420,7 +423,7 @@ module enc_qei_engine #(
 
   // A write of a register the lane uses (its configuration, COUNT_LO, SNAP_CTRL.CMD) waits for
   // the channel's push: c(v + 1)'s is taken in slot 9 (its data comes in slot 10). Any other (a
-  // state write: EVENTS, QERR_COUNT, GLITCH_COUNT, COUNT_HI, a saved COUNT_HI latch) is applied
+  // state write: EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN, COUNT_HI, a saved COUNT_HI latch) is applied
   // by the channel's next visit: c(v)'s is taken in slot 21 (its data comes in slot 22), so that
   // it acts on what the bus could read when it was written and not on the window after it.
   reg          n_taken, e_taken;
@@ -1341,7 +1344,8 @@ module enc_qei_engine #(
   // a write of a register the lane does not use (applied by the channel's next visit)
   wire        b_state_wr  = (b_word_q == off_of(ENC_QEI_EVENTS)) |
                             (b_word_q == off_of(ENC_QEI_QERR_COUNT)) |
-                            (b_word_q == off_of(ENC_QEI_GLITCH_COUNT)) | b_cnt_hi;
+                            (b_word_q == off_of(ENC_QEI_GLITCH_COUNT)) |
+                            (b_word_q == off_of(ENC_QEI_IRQ_EN)) | b_cnt_hi;
 
   always @(posedge clk) begin
     pend_we  <= 1'b0;
