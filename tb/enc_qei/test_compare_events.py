@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei compare, events and irq: COMPARE and cmp_out, every event set, masked, enabled onto
-irq and cleared by W1C, the error counters (QERR_COUNT, GLITCH_COUNT), CMP on count loads.
+irq and cleared by W1C, the error counters (QERR_COUNT, GLITCH_COUNT), CMP on count loads. A lean
+build has no compare unit: cmp_out stays 0 and CMP is never raised (its other events as a full
+build's).
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -15,7 +17,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, lacks, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, play_clocks
 from enctools.regmap import event_bits, get_field, pack
@@ -24,7 +26,8 @@ from enctools.tb import cocotb_test
 
 @cocotb_test()
 async def compare(dut):
-    """COMPARE: the CMP event and one cmp_out pulse each time the count changes to it."""
+    """COMPARE: the CMP event and one cmp_out pulse each time the count changes to it (a lean
+    build: neither, however often the count passes COMPARE)."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     pulses = 0
@@ -51,12 +54,14 @@ async def compare(dut):
     await env.check(model, "compare walk")
     mon.cancel()
     assert pulses == model.cmp_hits, f"cmp_out pulsed {pulses} times, model {model.cmp_hits}"
-    assert pulses >= 2, "the walk never reached COMPARE"
+    # (the first walk passes 104 six times; a lean build's model has no compare unit: 0 pulses)
+    assert pulses >= 2 or env.lean, "the walk never reached COMPARE"
 
 
 @cocotb_test()
 async def events_and_irq(dut):
-    """Every count-side event: set, masked, enabled onto irq, cleared alone by W1C."""
+    """Every count-side event: set, masked, enabled onto irq, cleared alone by W1C (the events
+    of the units a build has)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -67,9 +72,11 @@ async def events_and_irq(dut):
     async def make(name):
         if name == "OVERFLOW":
             await bus.set_count(model.max)
+            await env.applied()
             await env.play(walk([1], [45.0], start_pos=env.pos), None)
         elif name == "UNDERFLOW":
             await bus.set_count(0)
+            await env.applied()
             await env.play(walk([-1], [45.0], start_pos=env.pos), None)
         elif name == "DIR_CHANGE":
             await env.play(walk([1, -1], [45.0, 45.0], start_pos=env.pos), None)
@@ -103,9 +110,12 @@ async def events_and_irq(dut):
 
     names = ["OVERFLOW", "UNDERFLOW", "DIR_CHANGE", "CMP", "QERR", "GLITCH", "INDEX", "PROBE",
              "SNAP_READY", "PERIOD_READY", "STALL"]
+    if env.lean:  # (no compare, probe, period or stall unit)
+        names = [n for n in names if n not in ("CMP", "PROBE", "PERIOD_READY", "STALL")]
     for name in names:
         await bus.wr("IRQ_EN", 0)
         await bus.events()
+        await env.applied()
         await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=3, CMP_EN=1))
         await make(name)
         word = await bus.rd("EVENTS")
@@ -119,7 +129,7 @@ async def events_and_irq(dut):
         await env.settle(3)
         assert dut.irq.value == 1, f"irq low with {name} pending and enabled"
         # set a second event, then clear only the first: the second stays
-        other = "CMP" if name != "CMP" else "INDEX"
+        other = "CMP" if name != "CMP" and not env.lean else "INDEX" if name != "INDEX" else "QERR"
         await make(other)
         both = await bus.rd("EVENTS")
         assert both & event_bits(other), f"{other} not raised"
@@ -152,6 +162,7 @@ async def error_counters_wide(dut):
     await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=2))
     await env.settle(10)
     await bus.wr("GLITCH_COUNT", 0)
+    await env.applied()
     a = QUAD[env.pos % 4][0]
     for _ in range(n):
         await FallingEdge(dut.clk)
@@ -164,7 +175,7 @@ async def error_counters_wide(dut):
     await bus.events()
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def cmp_on_load(dut):
     """A COUNT load that makes the count equal COMPARE raises CMP and pulses cmp_out once, for one
     clock: a COUNT write and an index preset, from another count and from COMPARE itself (the
@@ -219,7 +230,7 @@ async def cmp_on_load(dut):
     mon.cancel()
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def compare_enable(dut):
     """CTRL.CMP_EN: with 0 (the reset value) a walk through COMPARE and a COUNT write of it raise
     no CMP and no cmp_out pulse; setting CMP_EN while the count equals COMPARE raises nothing; with
@@ -270,6 +281,6 @@ async def compare_enable(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_compare_events(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_compare_events(config):
+    run_feature(__name__, *config)
