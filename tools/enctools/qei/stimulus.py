@@ -179,12 +179,13 @@ class ClockWalk:
     ``p_reverse``, and its Z level is zfuns[k](position) (None: Z low). Every change is fed to the
     channel's model in order and marked on its Timeline with the timebase of its clock
     (TB_PRESCALE 0), so that a snapshot can be checked against the clock its SNAP_TIME names.
-    The channels' pins are the bits of the vectors a_in, b_in, z_in (one channel: bit 0)."""
+    Walk k drives bit bits[k] of the vectors a_in, b_in, z_in (default: bit k)."""
 
     def __init__(self, dut, models, rng, positions=None, shortest=1, longest=4, p_reverse=0.2,
-                 zfuns=None):
+                 zfuns=None, bits=None):
         self.dut, self.models, self.rng = dut, models, rng
         n = len(models)
+        self.bits = list(bits if bits is not None else range(n))
         self.pos = list(positions or [0] * n)
         self.z = [0] * n
         self.shortest, self.longest, self.p_reverse = shortest, longest, p_reverse
@@ -228,9 +229,10 @@ class ClockWalk:
                 self.pos[k] += self.dirs[k]
                 new = QUAD[self.pos[k] % 4]
                 zk = self.zfuns[k](self.pos[k]) if self.zfuns[k] else 0
-                a = a & ~(1 << k) | new[0] << k
-                b = b & ~(1 << k) | new[1] << k
-                z = z & ~(1 << k) | zk << k
+                bit = self.bits[k]
+                a = a & ~(1 << bit) | new[0] << bit
+                b = b & ~(1 << bit) | new[1] << bit
+                z = z & ~(1 << bit) | zk << bit
                 self.z[k] = zk
                 model = self.models[k]
                 model.sample(new, zk)
