@@ -107,12 +107,12 @@ module enc_qei #(
       $error("enc_qei: PROFILE lean (3) needs COUNT_W of at least 32");
 `endif
     end
-    // (the shared engine builds the lean profile, without the edge FIFO)
-    if (ENGINE != 0 && (PROFILE != P_LEAN || EFIFO_LOG2 != 0)) begin : g_bad_engine_build
+    // (the shared engine has no edge FIFO)
+    if (ENGINE != 0 && EFIFO_LOG2 != 0) begin : g_bad_engine_build
 `ifdef __ICARUS__
-      enc_qei__parameter_ENGINE_1_needs_PROFILE_lean_and_EFIFO_LOG2_0 u_stop ();
+      enc_qei__parameter_ENGINE_1_needs_EFIFO_LOG2_0 u_stop ();
 `else
-      $error("enc_qei: parameter ENGINE = 1 (shared) builds PROFILE 3 (lean) with EFIFO_LOG2 = 0");
+      $error("enc_qei: parameter ENGINE = 1 (shared) needs EFIFO_LOG2 = 0 (no edge FIFO)");
 `endif
     end
     // (the edge FIFO timestamps with the timing unit's timebase)
@@ -270,6 +270,7 @@ module enc_qei #(
 
       assign h2r_gsnap_time = zext_ts(gsnap_time_q);
     end else begin : g_no_timebase
+      wire unused_gsnap = &{1'b0, gsnap};
       assign timebase       = {TS_W{1'b0}};
       assign tick           = 1'b0;
       assign gsnap_req      = 1'b0;
@@ -319,18 +320,21 @@ module enc_qei #(
       end
     end else begin : g_engine
       // (the channel pages are the engine's: the register block has none)
-      wire unused_pages = &{1'b0, reg2hw_ch, probe_in, tick};
+      wire unused_pages = &{1'b0, reg2hw_ch};
       for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_no_page
         assign hw2reg_ch[ch*ENC_QEI_H2R_CH_W +: ENC_QEI_H2R_CH_W] = {ENC_QEI_H2R_CH_W{1'b0}};
       end
-      assign cmp_out   = {CHANNELS{1'b0}};
 
       enc_qei_engine #(
           .CHANNELS  (CHANNELS),
           .COUNT_W   (COUNT_W),
           .TS_W      (TS_W),
           .FUNC_MASK (FUNC_MASK),
-          .FIXED_FUNC(FIXED_FUNC)
+          .FIXED_FUNC(FIXED_FUNC),
+          .TIMING    (TIMING),
+          .RANGE     (RANGE),
+          .PROBE     (PROBE),
+          .PERIOD    (PERIOD)
       ) u_engine (
           .clk       (clk),
           .rst       (rst),
@@ -345,11 +349,14 @@ module enc_qei #(
           .a_in      (a_in),
           .b_in      (b_in),
           .z_in      (z_in),
+          .probe_in  (probe_in),
           .snap_in   (snap_in),
           .timebase  (timebase),
+          .tick      (tick),
           .gsnap_req (gsnap_req),
           .gsnap     (gsnap),
-          .irq_pend  (irq_pend)
+          .irq_pend  (irq_pend),
+          .cmp_out   (cmp_out)
       );
     end
   endgenerate

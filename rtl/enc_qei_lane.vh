@@ -3,76 +3,153 @@
 // positions of the record the lane hands over when it is read, and of the configuration the
 // engine pushes into it. Include it inside a module body that has the parameters MOT_W, TIM_W
 // and ERR_W (the lane's widths). Every position is a localparam computed from those widths; a
-// field of width 1 has only its position, wider ones also _W.
+// field of width 1 has only its position, wider ones also _W. Fields of units a profile leaves
+// out are 0 (and cost nothing).
+//
+// The count in a lane: lo = the count's low MOT_W bits, exact; its anchor: what lo counts from
+// since the last read: A_NONE the count the engine had at that read, A_LOAD a load (an index
+// preset: PRESET; a COUNT write: its value), A_ZERO a modulo wrap up (0), A_CEIL a modulo wrap
+// down (CEILING). The engine rebuilds a count as anchor value + (lo - the anchor value's low
+// bits), signed.
 //
 // The record (REC_W bits):
-//   R_MPOS     mpos: the count function's steps while CTRL.EN = 1 (the motion), mod 2^MOT_W, as
-//              of the read
-//   R_ICAP     mpos just after the last acting index edge of the window (its step included), and
-//   R_IPEND    1: there was one; R_IPRE: it was a preset (else a latch)
-//   R_SPEND    1: a snapshot was taken in the window, with what the lane held in its clock:
-//   R_SMPOS      mpos; R_SICAP, R_SIPEND, R_SIPRE: the index capture; R_STIME: timebase low bits;
-//   R_SET, R_SEMP, R_SNEW: the last selected edge's time and mpos, and whether it is in the
-//   window; R_SEDGE: a selected edge in the snapshot's own clock (time R_STIME, mpos R_SMPOS)
-//   R_ET, R_EMP, R_ENEW  the last selected edge (SNAP_CTRL.EDGE) of the window
-//   R_OVF, R_UNF, R_IDX, R_DCH  events of the window: overflow, underflow, a qualified index
-//              edge (armed or not), a direction change
-//   R_QCNT, R_GCNT  free-running counts of quadrature errors and of rejected levels, mod 2^ERR_W
-//   R_A, R_B, R_Z, R_DIR, R_ARMED  STATUS.A, B, Z, DIR, INDEX_ARMED now
+//   R_MPOS    mpos: the count function's steps while CTRL.EN = 1 (the motion), mod 2^MOT_W
+//   R_LO, R_ANC   lo and the last anchor since the read
+//   R_LPEND, R_LCAP, R_LANC   an index latch in the window: lo (after its step) and its anchor
+//   R_SPEND   a snapshot capture waits, with what the lane held in its clock: R_SMPOS, R_SLO,
+//             R_SANC mpos, lo, the anchor; R_STIME the timebase's low bits; R_SET, R_SEMP,
+//             R_SNEW the last selected edge's time and mpos and whether it is in the window;
+//             R_SEDGE a selected edge in the snapshot's own clock (then R_STIME, R_SMPOS)
+//   R_ET, R_EMP, R_ENEW   the last selected edge (SNAP_CTRL.EDGE) and whether it is in the window
+//   R_OVF, R_UNF, R_IDX, R_DCH, R_CMP   events of the window: overflow, underflow, a qualified
+//             index edge (armed or not), a direction change, a compare match
+//   R_QCNT, R_GCNT   free-running counts of quadrature errors and of rejected levels
+//   R_A, R_B, R_Z, R_DIR, R_ARMED, R_STOPPED   the STATUS bits now; R_ARM INDEX_CTRL.ARM now
+//   R_PPEND, R_PLO, R_PANC, R_PTIME   a probe latch in the window: lo, its anchor, the timebase's
+//             low bits; R_PEN PROBE_CTRL.EN now
+//   R_G       timebase ticks since the last restart of the stall timer (a step, or a new
+//             STALL_TIMEOUT), saturating; R_GRST a restart in the window, R_FST the time of the
+//             first one; R_SEV a stall the lane saw (STALL_TIMEOUT within its reach, C_STO);
+//             R_STALLED its STATUS.STALLED
+//   R_NB      period boundaries (every PERIOD_CTRL.N selected edges) in the window, 0 .. 3
+//   R_BST     a period measurement started in the window (the first edge after PERIOD_CTRL.EN)
+//   R_PRUN    a period measurement runs now
+//   R_BF, R_BT, R_BT0   the times of the window's first boundary or start, of its last one, and
+//             of the one before the last (when in the window); R_BDIR: the measurement that
+//             ended at the last boundary saw a direction change
+//   R_UHIT    the unit timer (SNAP_CTRL.PERIOD_EN) expired in the window; R_UARM, R_UD: it is
+//             armed now, for the time with these low bits
 // verilator lint_off UNUSEDPARAM
-localparam integer R_MPOS   = 0,                R_MPOS_W  = MOT_W;
-localparam integer R_ICAP   = R_MPOS + MOT_W,   R_ICAP_W  = MOT_W;
-localparam integer R_IPEND  = R_ICAP + MOT_W;
-localparam integer R_IPRE   = R_IPEND + 1;
-localparam integer R_SPEND  = R_IPRE + 1;
-localparam integer R_SMPOS  = R_SPEND + 1,      R_SMPOS_W = MOT_W;
-localparam integer R_SICAP  = R_SMPOS + MOT_W,  R_SICAP_W = MOT_W;
-localparam integer R_SIPEND = R_SICAP + MOT_W;
-localparam integer R_SIPRE  = R_SIPEND + 1;
-localparam integer R_STIME  = R_SIPRE + 1,      R_STIME_W = TIM_W;
-localparam integer R_SET    = R_STIME + TIM_W,  R_SET_W   = TIM_W;
-localparam integer R_SEMP   = R_SET + TIM_W,    R_SEMP_W  = MOT_W;
-localparam integer R_SNEW   = R_SEMP + MOT_W;
-localparam integer R_SEDGE  = R_SNEW + 1;
-localparam integer R_ET     = R_SEDGE + 1,      R_ET_W    = TIM_W;
-localparam integer R_EMP    = R_ET + TIM_W,     R_EMP_W   = MOT_W;
-localparam integer R_ENEW   = R_EMP + MOT_W;
-localparam integer R_OVF    = R_ENEW + 1;
-localparam integer R_UNF    = R_OVF + 1;
-localparam integer R_IDX    = R_UNF + 1;
-localparam integer R_DCH    = R_IDX + 1;
-localparam integer R_QCNT   = R_DCH + 1,        R_QCNT_W  = ERR_W;
-localparam integer R_GCNT   = R_QCNT + ERR_W,   R_GCNT_W  = ERR_W;
-localparam integer R_A      = R_GCNT + ERR_W;
-localparam integer R_B      = R_A + 1;
-localparam integer R_Z      = R_B + 1;
-localparam integer R_DIR    = R_Z + 1;
-localparam integer R_ARMED  = R_DIR + 1;
-localparam integer REC_W    = R_ARMED + 1;   // the record's width
+localparam integer A_NONE = 0, A_LOAD = 1, A_ZERO = 2, A_CEIL = 3;
+localparam integer R_MPOS    = 0,                 R_MPOS_W  = MOT_W;
+localparam integer R_LO      = R_MPOS + MOT_W,    R_LO_W    = MOT_W;
+localparam integer R_ANC     = R_LO + MOT_W,      R_ANC_W   = 2;
+localparam integer R_LPEND   = R_ANC + 2;
+localparam integer R_LCAP    = R_LPEND + 1,       R_LCAP_W  = MOT_W;
+localparam integer R_LANC    = R_LCAP + MOT_W,    R_LANC_W  = 2;
+localparam integer R_SPEND   = R_LANC + 2;
+localparam integer R_SMPOS   = R_SPEND + 1,       R_SMPOS_W = MOT_W;
+localparam integer R_SLO     = R_SMPOS + MOT_W,   R_SLO_W   = MOT_W;
+localparam integer R_SANC    = R_SLO + MOT_W,     R_SANC_W  = 2;
+localparam integer R_STIME   = R_SANC + 2,        R_STIME_W = TIM_W;
+localparam integer R_SET     = R_STIME + TIM_W,   R_SET_W   = TIM_W;
+localparam integer R_SEMP    = R_SET + TIM_W,     R_SEMP_W  = MOT_W;
+localparam integer R_SNEW    = R_SEMP + MOT_W;
+localparam integer R_SEDGE   = R_SNEW + 1;
+localparam integer R_ET      = R_SEDGE + 1,       R_ET_W    = TIM_W;
+localparam integer R_EMP     = R_ET + TIM_W,      R_EMP_W   = MOT_W;
+localparam integer R_ENEW    = R_EMP + MOT_W;
+localparam integer R_OVF     = R_ENEW + 1;
+localparam integer R_UNF     = R_OVF + 1;
+localparam integer R_IDX     = R_UNF + 1;
+localparam integer R_DCH     = R_IDX + 1;
+localparam integer R_CMP     = R_DCH + 1;
+localparam integer R_QCNT    = R_CMP + 1,         R_QCNT_W  = ERR_W;
+localparam integer R_GCNT    = R_QCNT + ERR_W,    R_GCNT_W  = ERR_W;
+localparam integer R_A       = R_GCNT + ERR_W;
+localparam integer R_B       = R_A + 1;
+localparam integer R_Z       = R_B + 1;
+localparam integer R_DIR     = R_Z + 1;
+localparam integer R_ARM     = R_DIR + 1;
+localparam integer R_ARMED   = R_ARM + 1;
+localparam integer R_STOPPED = R_ARMED + 1;
+localparam integer R_PPEND   = R_STOPPED + 1;
+localparam integer R_PLO     = R_PPEND + 1,       R_PLO_W   = MOT_W;
+localparam integer R_PANC    = R_PLO + MOT_W,     R_PANC_W  = 2;
+localparam integer R_PTIME   = R_PANC + 2,        R_PTIME_W = TIM_W;
+localparam integer R_PEN     = R_PTIME + TIM_W;
+localparam integer R_G       = R_PEN + 1,         R_G_W     = TIM_W;
+localparam integer R_GRST    = R_G + TIM_W;
+localparam integer R_FST     = R_GRST + 1,        R_FST_W   = TIM_W;
+localparam integer R_SEV     = R_FST + TIM_W;
+localparam integer R_STALLED = R_SEV + 1;
+localparam integer R_NB      = R_STALLED + 1,     R_NB_W    = 2;
+localparam integer R_BST     = R_NB + 2;
+localparam integer R_PRUN    = R_BST + 1;
+localparam integer R_BF      = R_PRUN + 1,        R_BF_W    = TIM_W;
+localparam integer R_BT      = R_BF + TIM_W,      R_BT_W    = TIM_W;
+localparam integer R_BT0     = R_BT + TIM_W,      R_BT0_W   = TIM_W;
+localparam integer R_BDIR    = R_BT0 + TIM_W;
+localparam integer R_UHIT    = R_BDIR + 1;
+localparam integer R_UARM    = R_UHIT + 1;
+localparam integer R_UD      = R_UARM + 1,        R_UD_W    = TIM_W;
+localparam integer REC_W     = R_UD + TIM_W;      // the record's width
 
 // The configuration (CFG_W bits): the channel's registers as the lane counts with them. CTRL:
 // EN, SWAP_AB, INV_A, INV_B, INV_Z, FUNC (as counted: a code no function has where FUNC_MASK
-// leaves it out), C_LAST = FILTER_LEN clamped to 1 .. 16, minus 1 (enc_filter_rt's last); INDEX_CTRL: ACTION, ONESHOT, EDGE, GATE_EN, GATE_A, GATE_B, ARM
-// (taken only with the lane's arm_we: the lane clears ARM itself); SNAP_CTRL: IN_EN, EDGE;
-// from PRESET: C_NEGP = -PRESET mod 2^MOT_W and C_VBP = 1 when PRESET is within the lane's reach
-// of the end of the free range (so an index preset knows where the count wraps).
-localparam integer C_EN      = 0;
-localparam integer C_SWAP    = 1;
-localparam integer C_INV_A   = 2;
-localparam integer C_INV_B   = 3;
-localparam integer C_INV_Z   = 4;
-localparam integer C_FUNC    = 5,             C_FUNC_W = 4;
-localparam integer C_LAST    = C_FUNC + 4,    C_LAST_W = 4;
-localparam integer C_ACT     = C_LAST + 4,    C_ACT_W  = 2;
-localparam integer C_ONESHOT = C_ACT + 2;
-localparam integer C_IEDGE   = C_ONESHOT + 1;
-localparam integer C_GATE_EN = C_IEDGE + 1;
-localparam integer C_GATE_A  = C_GATE_EN + 1;
-localparam integer C_GATE_B  = C_GATE_A + 1;
-localparam integer C_ARM     = C_GATE_B + 1;
-localparam integer C_SIN_EN  = C_ARM + 1;
-localparam integer C_SEDGE   = C_SIN_EN + 1;
-localparam integer C_NEGP    = C_SEDGE + 1,   C_NEGP_W = MOT_W;
-localparam integer C_VBP     = C_NEGP + MOT_W;
-localparam integer CFG_W     = C_VBP + 1;     // the configuration's width
+// leaves it out), C_LAST = FILTER_LEN clamped to 1 .. 16, minus 1 (enc_filter_rt's last),
+// RANGE, CMP_EN; INDEX_CTRL: ACTION, ONESHOT, EDGE, GATE_EN, GATE_A, GATE_B, ARM (taken only with
+// the lane's arm_we: the lane clears ARM itself); SNAP_CTRL: IN_EN, EDGE, PERIOD_EN (C_UEN);
+// PROBE_CTRL: EN (taken only with pen_we), EDGE, ONCE; PERIOD_CTRL: EN, EDGE, N - 1 (0 for 0);
+// C_STO: STALL_TIMEOUT when the lane times it (1 .. 2^TIM_W - 1), else 0 (off, or the engine
+// times it); C_UPER: SNAP_PERIOD (0 acts as 1) when the lane reloads its unit timer itself
+// (< 2^TIM_W), else 0; C_UD: the unit timer's time (low bits; taken only with u_we, which arms it);
+// C_PLO: PRESET's low bits (a COUNT write's value's, in the clock before its load); C_CLO, C_MLO:
+// CEILING's and COMPARE's low bits; the validity sets (V_*): C_VS_CNT for the count the engine
+// had at the lane's last read, C_VS_LOAD for PRESET (a COUNT write's value), C_VS_ZERO for 0,
+// C_VS_CEIL for CEILING, C_VSO_LOAD / C_VSO_CEIL for the PRESET / CEILING this configuration
+// replaces (an anchor taken before it). Every set is for this configuration's CEILING and
+// COMPARE. A validity set says, for a count near its value, which of these the lane's low bits
+// may stand for: V_B the end of the range (0 / all ones, within reach either way round), V_C
+// CEILING (within reach), V_AC the count is above CEILING (when not V_C), V_P COMPARE (within
+// reach).
+localparam integer V_B = 0, V_C = 1, V_AC = 2, V_P = 3, VS_W = 4;
+localparam integer C_EN       = 0;
+localparam integer C_SWAP     = 1;
+localparam integer C_INV_A    = 2;
+localparam integer C_INV_B    = 3;
+localparam integer C_INV_Z    = 4;
+localparam integer C_FUNC     = 5,                C_FUNC_W  = 4;
+localparam integer C_LAST     = C_FUNC + 4,       C_LAST_W  = 4;
+localparam integer C_RANGE    = C_LAST + 4,       C_RANGE_W = 2;
+localparam integer C_CMP_EN   = C_RANGE + 2;
+localparam integer C_ACT      = C_CMP_EN + 1,     C_ACT_W   = 2;
+localparam integer C_ONESHOT  = C_ACT + 2;
+localparam integer C_IEDGE    = C_ONESHOT + 1;
+localparam integer C_GATE_EN  = C_IEDGE + 1;
+localparam integer C_GATE_A   = C_GATE_EN + 1;
+localparam integer C_GATE_B   = C_GATE_A + 1;
+localparam integer C_ARM      = C_GATE_B + 1;
+localparam integer C_SIN_EN   = C_ARM + 1;
+localparam integer C_SEDGE    = C_SIN_EN + 1;
+localparam integer C_UEN      = C_SEDGE + 1;
+localparam integer C_PEN      = C_UEN + 1;
+localparam integer C_PEDGE    = C_PEN + 1;
+localparam integer C_PONCE    = C_PEDGE + 1;
+localparam integer C_PER_EN   = C_PONCE + 1;
+localparam integer C_PER_EDGE = C_PER_EN + 1;
+localparam integer C_PER_N    = C_PER_EDGE + 1,   C_PER_N_W = 8;
+localparam integer C_STO      = C_PER_N + 8,      C_STO_W   = TIM_W;
+localparam integer C_UPER     = C_STO + TIM_W,    C_UPER_W  = TIM_W;
+localparam integer C_UD       = C_UPER + TIM_W,   C_UD_W    = TIM_W;
+localparam integer C_PLO      = C_UD + TIM_W,     C_PLO_W   = MOT_W;
+localparam integer C_CLO      = C_PLO + MOT_W,    C_CLO_W   = MOT_W;
+localparam integer C_MLO      = C_CLO + MOT_W,    C_MLO_W   = MOT_W;
+localparam integer C_VS_CNT   = C_MLO + MOT_W;
+localparam integer C_VS_LOAD  = C_VS_CNT + VS_W;
+localparam integer C_VS_ZERO  = C_VS_LOAD + VS_W;
+localparam integer C_VS_CEIL  = C_VS_ZERO + VS_W;
+localparam integer C_VSO_LOAD = C_VS_CEIL + VS_W;
+localparam integer C_VSO_CEIL = C_VSO_LOAD + VS_W;
+localparam integer CFG_W      = C_VSO_CEIL + VS_W;  // the configuration's width
 // verilator lint_on UNUSEDPARAM

@@ -4,6 +4,6 @@
 // enc_qei_lane checks it at elaboration.
 `ifndef ENC_QEI_LANE_W_VH
 `define ENC_QEI_LANE_W_VH
-`define ENC_QEI_LANE_CFG_W(MOT) ((MOT) + 24)
-`define ENC_QEI_LANE_REC_W(MOT, TIM, ERR) (6 * (MOT) + 3 * (TIM) + 2 * (ERR) + 17)
+`define ENC_QEI_LANE_CFG_W(MOT, TIM) (3 * (MOT) + 3 * (TIM) + 64)
+`define ENC_QEI_LANE_REC_W(MOT, TIM, ERR) (8 * (MOT) + 10 * (TIM) + 2 * (ERR) + 37)
 `endif

@@ -7,7 +7,9 @@
  * -Werror and compares them on the same vectors). Arithmetic: integer wrap handling (timebase
  * modulo 2^TS_W, count modulo 2^COUNT_W), then one division in double precision per method. No
  * other floating point, no libm. Build with any C99 compiler; on an FPU-less target the three
- * divisions per reading go through the soft-float library.
+ * divisions per reading go through the soft-float library: there use the fixed-point version,
+ * enc_qei_velocity_fx.h (the same rules, readings within one unit of 2^-F count/s; on the
+ * simulated VexRiscv a channel's cycles drop from thousands to hundreds: doc/results/soc_sim.md).
  *
  * Input: one qei_vel_snap_t per read of the snapshot registers (rtl/enc_qei.rdl):
  *   count       SNAP_COUNT (COUNT_W bits, as read: {SNAP_COUNT_HI, SNAP_COUNT_LO})
@@ -110,8 +112,11 @@ double qei_vel_rpm(double counts_per_s, unsigned counts_per_rev);
  * that channel by bus command
  * (SNAP_CTRL.CMD, keeping the other SNAP_CTRL fields) and reads it, with PERIOD, PERIOD_CTRL and
  * STATUS right after (those three are live values, not latched with the snapshot). count_w is
- * CAPS.COUNT_W. On a bus that posts writes, make sure the SNAP_CTRL write lands before the
- * reads (a barrier, or read SNAP_CTRL back first).
+ * CAPS.COUNT_W. It reads the snapshot straight after the command, so it needs the command to
+ * act before the next read: true of the per-channel build on a bus that does not post writes,
+ * not necessarily of a shared-engine build (CAPS.ENGINE), which may show it later. Firmware
+ * for every build uses enc_qei_drv_snap_take() of sw/enc_qei_drv.h, which waits for
+ * EVENTS.SNAP_READY.
  */
 #ifdef ENC_QEI_REGS_H
 static inline void qei_vel_read_snapshot(volatile enc_qei_chan_t *q, unsigned count_w,

@@ -2,37 +2,51 @@
 /*
  * main.c -- enc_qei firmware for the simulated LiteX SoC (doc/litex.md).
  *
- * Uses, for the peripheral, only the generated register header (sw/enc_qei_regs.h) and the
- * velocity estimators (sw/enc_qei_velocity.c); from LiteX only the console, the interrupt
- * controller and the SoC's generated headers (ENC_QEI_BASE, ENC_QEI_INTERRUPT,
+ * Uses, for the peripheral, the driver API (sw/enc_qei_drv.c over the generated register header
+ * sw/enc_qei_regs.h) and one velocity estimator: the fixed-point one (sw/enc_qei_velocity_fx.c,
+ * readings in 2^-ENC_FW_FRAC count/s) or, built with ENC_FW_VEL_double, the double one
+ * (sw/enc_qei_velocity.c, software floating point on this CPU); from LiteX only the console, the
+ * interrupt controller and the SoC's generated headers (ENC_QEI_BASE, ENC_QEI_INTERRUPT,
  * CONFIG_CLOCK_FREQUENCY).
  *
- * 1. Finds the build in ID and CAPS (channel count, profile, widths; it needs the timing unit:
- *    full or lean) and sets up every channel: x4, FILTER_LEN 3, free range, index latch on every
- *    index, snapshots timing A-rising edges; with an edge FIFO (CAPS.EFIFO_LOG2 > 0) each
- *    channel's FIFO is cleared and enabled.
+ * 1. Finds the build (enc_qei_drv_init: ID, CAPS; it needs the timing unit: full or lean) and
+ *    sets up every channel: x4, FILTER_LEN 3, free range, index latch on every index, snapshots
+ *    timing A-rising edges; with an edge FIFO (CAPS.EFIFO_LOG2 > 0) each channel's FIFO is
+ *    cleared and enabled.
  * 2. Runs the global unit timer at 1 kHz (GSNAP_PERIOD, PERIOD_EN): one snapshot of all channels
  *    per millisecond, one interrupt (EVENTS.SNAP_READY of channel 0, found through IRQ_SUMMARY).
- * 3. The interrupt handler reads every channel's snapshot registers (SNAP_COUNT, SNAP_TIME,
- *    SNAP_EDGE_TIME, SNAP_DELTA, SNAP_EDGE_DELTA: one instant), computes position and velocity
- *    (qei_vel_update: the timestamp method, with its stall rule at 20 ms), counts its own CPU
- *    cycles (mcycle) after each channel, and stores one record. Meanwhile the main loop drains
- *    the edge FIFOs (if any) and keeps statistics of their entries. After ENC_FW_SNAPSHOTS
- *    snapshots the main loop stops the timer and the FIFOs, drains them, prints the records as
- *    a table, the cycle summary, the FIFO statistics, reads one unmapped offset (what the bus
- *    does with it), prints DONE and ends the simulation.
+ * 3. The interrupt handler reads every channel's part of the snapshot (enc_qei_drv_snap_read:
+ *    wait for its SNAP_READY, clear it, SNAP_COUNT, SNAP_TIME, SNAP_EDGE_TIME, SNAP_DELTA,
+ *    SNAP_EDGE_DELTA), computes position and velocity (the timestamp method, with its stall rule
+ *    at 20 ms), counts its own CPU cycles (mcycle) after each channel, and stores one record.
+ *    Meanwhile the main loop drains the edge FIFOs (if any) and keeps statistics of their
+ *    entries. After ENC_FW_SNAPSHOTS snapshots the main loop stops the timer and the FIFOs,
+ *    drains them, takes one global snapshot by command (enc_qei_drv_gsnap_take), prints the
+ *    records as a table, the cycle summary, the FIFO statistics, reads one unmapped offset (what
+ *    the bus does with it), prints DONE and ends the simulation.
  *
  * Lines of the output (tools/enctools/litex/check.py parses them):
- *   BUILD <channels> <profile> <count_w> <ts_w> <clock_hz> <period_ticks> <efifo_log2>
+ *   BUILD <channels> <profile> <count_w> <ts_w> <clock_hz> <period_ticks> <efifo_log2> <engine>
+ *         <vel>
+ *        engine: CAPS.ENGINE (1: the channels share one engine); vel: "double" (velocities
+ *        printed to 0.001 count/s) or "fx<F>" (the fixed-point reading printed exactly: F
+ *        decimals)
  *   S <n> <gsnap_time> <latency> <cycles> | <pos_k> <vel_k> | ...
  *        one per snapshot: GSNAP_TIME, TIMEBASE at the handler's entry minus GSNAP_TIME (the
  *        interrupt latency: trap entry and LiteX's dispatch, in clocks), the handler's cycles,
  *        and per channel the position (count steps) and the velocity (count steps per second,
  *        timestamp method)
  *   C <k> <min> <mean> <max>     handler cycles from its entry to channel k - 1 done
+ *   F <min> <mean> <max>         handler cycles from its entry to the first channel's read (the
+ *                                fixed part: TIMEBASE, IRQ_SUMMARY, EVENTS)
+ *   D <k> <min> <mean> <max>     cycles of channel k - 1 alone: its snapshot read, velocity and
+ *                                record
  *   X <k> <count> <index_latch> <qerr_count> <glitch_count>    channel k at the end
- *   M <missed> <torn> <skewed>   snapshots missed; read while the next one landed; a channel's
- *                                SNAP_TIME other than GSNAP_TIME
+ *   M <missed> <torn> <skewed> <errors>   snapshots missed; GSNAP_TIME after the reads other
+ *                                than channel 0's SNAP_TIME (a newer snapshot landed meanwhile);
+ *                                channels whose SNAP_TIME differs from channel 0's; driver
+ *                                calls that failed
+ *   G <err> <gsnap_time> <pos_0> ... <pos_k>   the global snapshot by command at the end
  *   E <k> <entries> <net> <dir_changes> <idx> <lost> <nonmono> <ab_bad> <t_first> <t_last>
  *     <sum_t> <efifo_lost> <cycles>      channel k's edge FIFO, every entry drained: their
  *        number, the sum of their directions (+1/-1), direction changes between consecutive
@@ -56,29 +70,41 @@
 #include <generated/mem.h>
 #include <generated/soc.h>
 
-#include "enc_qei_regs.h"
+#include "enc_qei_drv.h"
+#ifdef ENC_FW_VEL_double
 #include "enc_qei_velocity.h"
+#else
+#include "enc_qei_velocity_fx.h"
+#endif
 
 #ifndef ENC_FW_SNAPSHOTS
 #define ENC_FW_SNAPSHOTS 100
 #endif
+#ifndef ENC_FW_FRAC
+#define ENC_FW_FRAC 8u          /* fixed point: 1/256 count/s, up to 8,388,607 count/s */
+#endif
 #define SNAP_HZ 1000u
 #define STALL_MS 20u
+#define SNAP_READY ENC_QEI__EVENTS__SNAP_READY_bm
 
-static volatile enc_qei_t *const q = (volatile enc_qei_t *)ENC_QEI_BASE;
-
-static unsigned channels, profile, count_w, ts_w, efifo_log2;
+static enc_qei_dev_t dev;
+static volatile enc_qei_t *q;   /* dev.regs: the registers the driver does not cover */
 static uint32_t period_ticks;
+#ifdef ENC_FW_VEL_double
 static qei_vel_t vel_state[ENC_QEI_CHANNELS_MAX];
+#else
+static qei_velfx_t vel_state[ENC_QEI_CHANNELS_MAX];
+#endif
 
 /* the records, one per snapshot */
 static uint32_t rec_time[ENC_FW_SNAPSHOTS];
 static uint32_t rec_latency[ENC_FW_SNAPSHOTS];
+static uint32_t rec_fix[ENC_FW_SNAPSHOTS];                        /* cycles before channel 0 */
 static int32_t rec_pos[ENC_FW_SNAPSHOTS][ENC_QEI_CHANNELS_MAX];
-static int64_t rec_vel[ENC_FW_SNAPSHOTS][ENC_QEI_CHANNELS_MAX];   /* count steps/s x 1000 */
+static int64_t rec_vel[ENC_FW_SNAPSHOTS][ENC_QEI_CHANNELS_MAX];   /* the printing's unit */
 static uint32_t rec_cyc[ENC_FW_SNAPSHOTS][ENC_QEI_CHANNELS_MAX];  /* cycles after channel k */
 static volatile unsigned n_rec;
-static unsigned missed, torn, skewed;
+static unsigned missed, torn, skewed, drv_errors;
 
 /* the edge FIFOs' statistics, one per channel (the E lines) */
 struct efifo_stat {
@@ -97,62 +123,58 @@ static inline uint32_t cycles(void)
     return c;
 }
 
-static int64_t to_milli(double v)
+/* the velocity of channel k from its snapshot: count steps per second x 1000 (double) or in
+ * 2^-ENC_FW_FRAC count steps per second (fixed point), the timestamp method */
+#ifdef ENC_FW_VEL_double
+static int64_t velocity(unsigned k, const qei_vel_snap_t *s)
 {
-    double m = v * 1000.0;
+    double m = qei_vel_update(&vel_state[k], s).mt * 1000.0;
     return (int64_t)(m < 0.0 ? m - 0.5 : m + 0.5);
 }
-
-static void read_channel(unsigned k, qei_vel_snap_t *s)
+#else
+static int64_t velocity(unsigned k, const qei_vel_snap_t *s)
 {
-    volatile enc_qei_chan_t *ch = &q->chan[k];
-    volatile enc_qei_chan_t *cnt = ch;
-#ifdef ENC_FW_FAULT_page
-    cnt = &q->chan[(k + 1u) % channels];
-#endif
-    s->count = cnt->SNAP_COUNT_LO;
-    if (count_w > 32u)
-        s->count |= (uint64_t)cnt->SNAP_COUNT_HI << 32;
-    s->time = ch->SNAP_TIME;
-    s->edge_time = ch->SNAP_EDGE_TIME;
-    s->delta = (int32_t)ch->SNAP_DELTA;
-    s->edge_delta = (int32_t)ch->SNAP_EDGE_DELTA;
-    s->period_n = 1u;                  /* no period capture: the timestamp method needs none */
-    s->period = 0u;
-    s->period_ovf = s->period_dir_change = 0u;
-    s->stalled = 0u;                   /* the stall rule from the snapshot's own times */
+    return qei_velfx_update_mt(&vel_state[k], s);   /* the timestamp method only */
 }
+#endif
 
-static int64_t to_signed(uint64_t count)
+static int read_channel(unsigned k, qei_vel_snap_t *s)
 {
-    if (count_w < 64u && (count >> (count_w - 1u)) & 1u)
-        return (int64_t)(count | (~(uint64_t)0 << count_w));
-    return (int64_t)count;
+    int err = enc_qei_drv_snap_read(&dev, k, s, 0u);
+#ifdef ENC_FW_FAULT_page
+    s->count = q->chan[(k + 1u) % dev.channels].SNAP_COUNT_LO;
+#endif
+    return err;
 }
 
 /* One global snapshot: every channel's registers, position and velocity, cycles per channel.
  * c0 and entry: mcycle and TIMEBASE at the handler's first instructions. */
 static void snapshot(uint32_t c0, uint32_t entry)
 {
-    uint32_t t = q->glb.GSNAP_TIME;
     unsigned n = n_rec;
+    uint32_t t, t0 = 0u, fix;
     static uint32_t last_t;
     static int have_last;
 
-    if (n >= ENC_FW_SNAPSHOTS)
+    if (n >= ENC_FW_SNAPSHOTS) {      /* done recording: only acknowledge it */
+        enc_qei_drv_events_clear(&dev, 0u, SNAP_READY);
         return;
-    for (unsigned k = 0; k < channels; k++) {
+    }
+    fix = cycles() - c0;
+    for (unsigned k = 0; k < dev.channels; k++) {
         qei_vel_snap_t s;
-        qei_vel_reading_t r;
-        read_channel(k, &s);
-        if (s.time != t)
+        if (read_channel(k, &s) != ENC_QEI_DRV_OK)
+            drv_errors++;
+        if (k == 0u)
+            t0 = s.time;
+        else if (s.time != t0)
             skewed++;
-        r = qei_vel_update(&vel_state[k], &s);
-        rec_pos[n][k] = (int32_t)to_signed(s.count);
-        rec_vel[n][k] = to_milli(r.mt);
+        rec_pos[n][k] = (int32_t)enc_qei_drv_signed(&dev, s.count);
+        rec_vel[n][k] = velocity(k, &s);
         rec_cyc[n][k] = cycles() - c0;
     }
-    if (q->glb.GSNAP_TIME != t)
+    t = q->glb.GSNAP_TIME;       /* after the channels: each has shown this snapshot */
+    if (t != t0)
         torn++;
     if (have_last && (uint32_t)(t - last_t) != period_ticks)
         missed += (uint32_t)(t - last_t) / period_ticks - 1u;
@@ -160,6 +182,7 @@ static void snapshot(uint32_t c0, uint32_t entry)
     have_last = 1;
     rec_time[n] = t;
     rec_latency[n] = entry - t;
+    rec_fix[n] = fix;
     n_rec = n + 1u;
 }
 
@@ -218,63 +241,63 @@ static void qei_isr(void)
 {
     uint32_t c0 = cycles();
     uint32_t entry = q->glb.TIMEBASE;
-    uint32_t pending = q->glb.IRQ_SUMMARY;
+    uint32_t pending = enc_qei_drv_irq_pending(&dev);
     for (unsigned k = 0; pending != 0u; k++, pending >>= 1) {
         if (!(pending & 1u))
             continue;
-        volatile enc_qei_chan_t *ch = &q->chan[k];
-        uint32_t ev = ch->EVENTS & ch->IRQ_EN;
-        ch->EVENTS = ev;                        /* W1C: exactly the bits handled */
-        if (ev & ENC_QEI__EVENTS__SNAP_READY_bm)
-            snapshot(c0, entry);
+        if (k == 0u && (enc_qei_drv_events(&dev, 0u) & dev.irq_en[0] & SNAP_READY))
+            snapshot(c0, entry);              /* clears SNAP_READY of every channel */
+        (void)enc_qei_drv_events_take(&dev, k);   /* any other enabled event: none here */
     }
 }
 
 static int discover(void)
 {
-    uint32_t id = q->glb.ID, caps = q->glb.CAPS;
-    uint32_t version = ENC_QEI__ID__VERSION_GET(id);
-    if (ENC_QEI__ID__MAGIC_GET(id) != ENC_QEI__ID__MAGIC_reset || (version >> 8) != 1u ||
-        (version & 0xFFu) < 1u) {
-        printf("enc_qei: no enc_qei 1.1+ at 0x%08lx (ID 0x%08lx)\n", (unsigned long)ENC_QEI_BASE,
-               (unsigned long)id);
+    int err = enc_qei_drv_init(&dev, (volatile enc_qei_t *)ENC_QEI_BASE);
+    if (err != ENC_QEI_DRV_OK) {
+        printf("enc_qei: %s at 0x%08lx (ID 0x%08lx)\n", enc_qei_drv_strerror(err),
+               (unsigned long)ENC_QEI_BASE, (unsigned long)dev.id);
         return -1;
     }
-    channels = ENC_QEI__CAPS__CHANNELS_GET(caps);
-    profile = ENC_QEI__CAPS__PROFILE_GET(caps);
-    count_w = ENC_QEI__CAPS__COUNT_W_GET(caps);
-    ts_w = ENC_QEI__CAPS__TS_W_GET(caps);
-    efifo_log2 = ENC_QEI__CAPS__EFIFO_LOG2_GET(caps);
-    if (!(caps & ENC_QEI__CAPS__TIMING_bm) || channels < 1u || channels > ENC_QEI_CHANNELS_MAX) {
-        printf("enc_qei: CAPS 0x%08lx: this firmware needs the timing unit\n", (unsigned long)caps);
+    if (!dev.has_timing) {
+        printf("enc_qei: CAPS 0x%08lx: this firmware needs the timing unit\n",
+               (unsigned long)dev.caps);
         return -1;
     }
+    q = dev.regs;
     return 0;
 }
 
 static void setup(void)
 {
     uint32_t clk = CONFIG_CLOCK_FREQUENCY;
+#ifdef ENC_FW_VEL_double
     qei_vel_cfg_t cfg = {0};
-
     cfg.tick_s = 1.0 / (double)clk;     /* TB_PRESCALE = 0: one tick per clock */
-    cfg.ts_w = ts_w;
-    cfg.count_w = count_w;
+#else
+    qei_velfx_cfg_t cfg = {0};
+    cfg.tick_hz = clk;                  /* TB_PRESCALE = 0: one tick per clock */
+    cfg.frac_bits = ENC_FW_FRAC;
+#endif
+    cfg.ts_w = dev.ts_w;
+    cfg.count_w = dev.count_w;
     cfg.counts_per_edge = 4u;           /* x4 counting, A-rising edges */
     cfg.stall_ticks = clk / 1000u * STALL_MS;
     q->glb.TB_PRESCALE = 0u;
-    for (unsigned k = 0; k < channels; k++) {
+    period_ticks = clk / SNAP_HZ;
+    enc_qei_drv_gsnap_config(&dev, 0u, period_ticks);
+    for (unsigned k = 0; k < dev.channels; k++) {
         volatile enc_qei_chan_t *ch = &q->chan[k];
         ch->CTRL = ENC_QEI__CTRL__EN_bm | ENC_QEI__CTRL__FUNC__X4_bm |
                    ENC_QEI__CTRL__RANGE__FREE_bm | ENC_QEI__CTRL__FILTER_LEN_SET(3u);
         ch->INDEX_CTRL = ENC_QEI__INDEX_CTRL__ACTION__LATCH_bm |
                          ENC_QEI__INDEX_CTRL__EDGE__RISING_bm | ENC_QEI__INDEX_CTRL__ARM_bm;
-        ch->SNAP_CTRL = ENC_QEI__SNAP_CTRL__EDGE__A_RISING_bm;
-        ch->IRQ_EN = 0u;
-        ch->EVENTS = 0xFFFFFFFFu;      /* clear what reset and setup raised */
+        enc_qei_drv_snap_config(&dev, k, ENC_QEI__SNAP_CTRL__EDGE__A_RISING_bm);
+        enc_qei_drv_irq_disable(&dev, k, 0xFFFFFFFFu);
+        enc_qei_drv_events_clear(&dev, k, 0xFFFFFFFFu);   /* what reset and setup raised */
         ch->QERR_COUNT = 0u;
         ch->GLITCH_COUNT = 0u;
-        if (efifo_log2) {
+        if (dev.efifo_log2) {
             uint32_t st = ch->STATUS;
             efifo[k].phase = ab_phase(ENC_QEI__STATUS__A_GET(st), ENC_QEI__STATUS__B_GET(st));
             /* a clean start: CLEAR with EN = 1 in the one write (THRESH at its reset value) */
@@ -282,23 +305,56 @@ static void setup(void)
                              ENC_QEI__EFIFO_CTRL__CLEAR_bm;
             ch->EFIFO_LOST = 0u;
         }
+#ifdef ENC_FW_VEL_double
         qei_vel_init(&vel_state[k], &cfg);
+#else
+        qei_velfx_init(&vel_state[k], &cfg);
+#endif
     }
-    period_ticks = clk / SNAP_HZ;
-    q->glb.GSNAP_PERIOD = period_ticks;
-    q->chan[0].IRQ_EN = ENC_QEI__EVENTS__SNAP_READY_bm;   /* one interrupt per global snapshot */
+    enc_qei_drv_irq_enable(&dev, 0u, SNAP_READY);   /* one interrupt per global snapshot */
 }
 
-static void print_milli(int64_t v)
+/* a velocity record as printed: double x 1000 with 3 decimals, fixed point with F decimals
+ * (2^-F = 5^F / 10^F: exact) */
+static void print_vel(int64_t v)
 {
-    uint64_t a = v < 0 ? (uint64_t)-v : (uint64_t)v;
+    uint64_t a = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
+#ifdef ENC_FW_VEL_double
     printf(" %s%llu.%03u", v < 0 ? "-" : "", (unsigned long long)(a / 1000u),
            (unsigned)(a % 1000u));
+#else
+    uint64_t frac = a & ((1u << ENC_FW_FRAC) - 1u);
+    for (unsigned i = 0; i < ENC_FW_FRAC; i++)
+        frac *= 5u;
+    printf(" %s%llu.%0*llu", v < 0 ? "-" : "", (unsigned long long)(a >> ENC_FW_FRAC),
+           (int)ENC_FW_FRAC, (unsigned long long)frac);
+#endif
+}
+
+/* min, mean, max of x[1 .. n-1] (the first record initialises the estimators and warms the
+ * caches: left out) */
+static void stats(const char *tag, unsigned k, const uint32_t *x, unsigned stride, unsigned n)
+{
+    uint32_t lo = UINT32_MAX, hi = 0u;
+    uint64_t sum = 0u;
+    for (unsigned i = 1; i < n; i++) {
+        uint32_t c = x[i * stride];
+        lo = c < lo ? c : lo;
+        hi = c > hi ? c : hi;
+        sum += c;
+    }
+    if (k)
+        printf("%s %u %lu %lu %lu\n", tag, k, (unsigned long)lo,
+               (unsigned long)(n > 1u ? sum / (n - 1u) : 0u), (unsigned long)hi);
+    else
+        printf("%s %lu %lu %lu\n", tag, (unsigned long)lo,
+               (unsigned long)(n > 1u ? sum / (n - 1u) : 0u), (unsigned long)hi);
 }
 
 static void report(void)
 {
-    unsigned n = n_rec;
+    static uint32_t own[ENC_FW_SNAPSHOTS];
+    unsigned n = n_rec, channels = dev.channels;
     printf("\n  snap   gsnap_time  lat   cyc");
     for (unsigned k = 0; k < channels; k++)
         printf(" | pos%u vel%u", k, k);
@@ -308,31 +364,29 @@ static void report(void)
                (unsigned long)rec_latency[i], (unsigned long)rec_cyc[i][channels - 1u]);
         for (unsigned k = 0; k < channels; k++) {
             printf(" | %ld", (long)rec_pos[i][k]);
-            print_milli(rec_vel[i][k]);
+            print_vel(rec_vel[i][k]);
         }
         printf("\n");
     }
-    /* the first record initialises the estimators and warms the caches: leave it out */
+    for (unsigned k = 0; k < channels; k++)
+        stats("C", k + 1u, &rec_cyc[0][k], ENC_QEI_CHANNELS_MAX, n);
+    stats("F", 0u, rec_fix, 1u, n);
     for (unsigned k = 0; k < channels; k++) {
-        uint32_t lo = UINT32_MAX, hi = 0u;
-        uint64_t sum = 0u;
-        for (unsigned i = 1; i < n; i++) {
-            uint32_t c = rec_cyc[i][k];
-            lo = c < lo ? c : lo;
-            hi = c > hi ? c : hi;
-            sum += c;
-        }
-        printf("C %u %lu %lu %lu\n", k + 1u, (unsigned long)lo,
-               (unsigned long)(n > 1u ? sum / (n - 1u) : 0u), (unsigned long)hi);
+        for (unsigned i = 0; i < n; i++)
+            own[i] = rec_cyc[i][k] - (k ? rec_cyc[i][k - 1u] : rec_fix[i]);
+        stats("D", k + 1u, own, 1u, n);
     }
     for (unsigned k = 0; k < channels; k++) {
         volatile enc_qei_chan_t *ch = &q->chan[k];
-        uint32_t count = ch->COUNT_LO;
-        printf("X %u %ld %ld %lu %lu\n", k, (long)(int32_t)count, (long)(int32_t)ch->INDEX_LATCH_LO,
+        int64_t pos = 0;
+        if (enc_qei_drv_read_position(&dev, k, &pos) != ENC_QEI_DRV_OK)
+            drv_errors++;
+        printf("X %u %ld %ld %lu %lu\n", k, (long)pos,
+               (long)enc_qei_drv_signed(&dev, ch->INDEX_LATCH_LO),
                (unsigned long)ch->QERR_COUNT, (unsigned long)ch->GLITCH_COUNT);
     }
-    printf("M %u %u %u\n", missed, torn, skewed);
-    for (unsigned k = 0; efifo_log2 && k < channels; k++) {
+    printf("M %u %u %u %u\n", missed, torn, skewed, drv_errors);
+    for (unsigned k = 0; dev.efifo_log2 && k < channels; k++) {
         const struct efifo_stat *f = &efifo[k];
         printf("E %u %lu %ld %lu %lu %lu %lu %lu %lu %lu %lu %lu %lu\n", k, (unsigned long)f->n,
                (long)f->net, (unsigned long)f->dir_changes, (unsigned long)f->idx,
@@ -340,6 +394,18 @@ static void report(void)
                (unsigned long)f->t_first, (unsigned long)f->t_last, (unsigned long)f->sum_t,
                (unsigned long)q->chan[k].EFIFO_LOST, (unsigned long)f->cycles);
     }
+}
+
+/* One global snapshot by command, after the timer stopped: the G line. */
+static void command_snapshot(void)
+{
+    qei_vel_snap_t s[ENC_QEI_CHANNELS_MAX];
+    uint32_t t = 0u;
+    int err = enc_qei_drv_gsnap_take(&dev, &t, s, 0u);
+    printf("G %d %lu", err, (unsigned long)t);
+    for (unsigned k = 0; k < dev.channels; k++)
+        printf(" %ld", (long)enc_qei_drv_signed(&dev, s[k].count));
+    printf("\n");
 }
 
 /* One read of an offset no register uses (0xFC of page 0: unmapped in every build). The
@@ -371,28 +437,39 @@ int main(void)
         printf("FAIL\n");
     } else {
         setup();
-        printf("BUILD %u %u %u %u %lu %lu %u\n", channels, profile, count_w, ts_w,
-               (unsigned long)CONFIG_CLOCK_FREQUENCY, (unsigned long)period_ticks, efifo_log2);
+#ifdef ENC_FW_VEL_double
+        const char *vel = "double";
+#else
+        const char *vel = "fx";
+#endif
+        printf("BUILD %u %u %u %u %lu %lu %u %lu %s", dev.channels, dev.profile, dev.count_w,
+               dev.ts_w, (unsigned long)CONFIG_CLOCK_FREQUENCY, (unsigned long)period_ticks,
+               dev.efifo_log2, (unsigned long)ENC_QEI__CAPS__ENGINE_GET(dev.caps), vel);
+#ifndef ENC_FW_VEL_double
+        printf("%u", ENC_FW_FRAC);
+#endif
+        printf("\n");
         irq_attach(ENC_QEI_INTERRUPT, qei_isr);
         enc_qei_ev_enable_write(1);
         irq_setmask(irq_getmask() | (1u << ENC_QEI_INTERRUPT));
         irq_setie(1);
-        q->glb.GSNAP_CTRL = ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm;
+        enc_qei_drv_gsnap_config(&dev, ENC_QEI__GSNAP_CTRL__PERIOD_EN_bm, period_ticks);
         while (n_rec < ENC_FW_SNAPSHOTS)
-            for (unsigned k = 0; efifo_log2 && k < channels; k++)
+            for (unsigned k = 0; dev.efifo_log2 && k < dev.channels; k++)
                 drain(k);
-        q->glb.GSNAP_CTRL = 0u;
+        enc_qei_drv_gsnap_config(&dev, 0u, period_ticks);
         irq_setmask(irq_getmask() & ~(1u << ENC_QEI_INTERRUPT));
-        if (efifo_log2) {
+        if (dev.efifo_log2) {
             unsigned popped;
-            for (unsigned k = 0; k < channels; k++)
+            for (unsigned k = 0; k < dev.channels; k++)
                 q->chan[k].EFIFO_CTRL = ENC_QEI_EFIFO_CTRL_RESET;   /* EN = 0: no more entries */
             do {                    /* until a whole pass finds every FIFO empty */
                 popped = 0u;
-                for (unsigned k = 0; k < channels; k++)
+                for (unsigned k = 0; k < dev.channels; k++)
                     popped += drain(k);
             } while (popped);
         }
+        command_snapshot();
         report();
         unmapped_read();
     }

@@ -25,7 +25,7 @@ from enctools.tb import cocotb_test
 
 # (top, CHANNELS, PROFILE, COUNT_W, TS_W, ENGINE)
 CHANNEL_CONFIGS = (("enc_qei_wb", 3, "full", 32, 32, 0), ("enc_qei_axil", 4, "lean", 32, 32, 0),
-                   ("enc_qei_wb", 3, "lean", 32, 32, 1))
+                   ("enc_qei_wb", 3, "lean", 32, 32, 1), ("enc_qei_axil", 3, "full", 32, 32, 1))
 SNAP_REGS = ("SNAP_COUNT_LO", "SNAP_COUNT_HI", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA",
              "SNAP_EDGE_DELTA")
 CHAN_REGS = tuple(n for n, r in regmap().items() if r.group == "chan")
@@ -350,9 +350,10 @@ async def lanes_probe_compare_per_channel(dut):
         for e in envs:
             await e.bus.events()
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
+        await bus.rd("PROBE_CTRL")  # (the shared engine: a read returns once the write took effect)
         await FallingEdge(dut.clk)
         dut.probe_in.value = 1 << k
-        await ClockCycles(dut.clk, FILTER + 8)
+        await ClockCycles(dut.clk, FILTER + 8 + env.lag)
         ev = await bus.rd("EVENTS")
         assert ev & probe_ev, f"channel {k}: no PROBE event while its probe_in is high (EVENTS {ev:#x})"
         await FallingEdge(dut.clk)

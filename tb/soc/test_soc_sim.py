@@ -2,14 +2,19 @@
 """enc_qei in a simulated LiteX SoC, its firmware against the motion model (`make soc-sim`).
 
 The SoC (VexRiscv, ROM, SRAM, UART, 4 full channels driven by tools/enctools/litex/motion.py)
-runs sw/soc/main.c: discovery from ID and CAPS, the 1 kHz global snapshot, the interrupt
-handler's positions and velocities. enctools.litex.check compares what it printed with the model
-(its docstring states the velocity bound). The firmware built with FW_FAULT=page reads one
+runs sw/soc/main.c: discovery from ID and CAPS through the driver API, the 1 kHz global
+snapshot, the interrupt handler's positions and velocities, a command snapshot at the end.
+enctools.litex.check compares what it printed with the model (its docstring states the velocity bound); the firmware
+runs twice, with the fixed-point estimator (the default: its readings within one unit of the
+double estimator on the model's registers, in fewer than 500 cycles a channel, no floating point
+linked) and with the double one (FW_VEL=double). The firmware built with FW_FAULT=page reads one
 register from the wrong channel page, and the same check must fail on it. The edge-FIFO build
 (simsoc.EFIFO: 3 channels, 256 entries each) runs the same firmware, which drains the FIFOs;
 check.check_efifo compares the entries with the model's steps, and must fail on the firmware
-built with FW_FAULT=efifo (an entry's direction from the wrong bit). Both builds read one
-unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and reads all ones.
+built with FW_FAULT=efifo (an entry's direction from the wrong bit). A third build (simsoc.ENGINE:
+the lean profile, the channels sharing one engine) runs the same firmware. The main and the
+edge-FIFO builds read one unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and
+reads all ones.
 
 Run by `make soc-sim` (ENC_SOC_SIM=1), after scripts/soc_sim.py has built the simulator; the
 builds and runs are cached, so this reuses them. Skipped by `make test`.
@@ -17,6 +22,7 @@ builds and runs are cached, so this reuses them. Skipped by `make test`.
 
 from __future__ import annotations
 
+import copy
 import os
 
 import pytest
@@ -24,16 +30,16 @@ import pytest
 if os.environ.get("ENC_SOC_SIM") != "1":
     pytest.skip("the LiteX SoC simulation runs under `make soc-sim`", allow_module_level=True)
 
-from enctools.litex import check, simsoc  # noqa: E402
+from enctools.litex import check, cli, simsoc  # noqa: E402
 
 CFG = simsoc.MAIN
 ECFG = simsoc.EFIFO
 BUS_TIMEOUT = 10**6   # LiteX's Wishbone timeout (SoCCore bus_timeout), in clocks
 
 
-def _run(fault=None, cfg=CFG):
+def _run(fault=None, cfg=CFG, vel="fixed"):
     simsoc.build_gateware(cfg)
-    fw = simsoc.build_firmware(cfg, fault)
+    fw = simsoc.build_firmware(cfg, fault, vel)
     out, _ = simsoc.run(cfg, fw)
     run = check.parse(out)
     return (run, *check.check_run(cfg.motions(), run))
@@ -52,14 +58,22 @@ def test_firmware_finds_the_build(good):
     run, res = good
     assert run.done, "the firmware did not print DONE"
     assert run.build == {"channels": CFG.channels, "profile": 2, "count_w": 32, "ts_w": 32,
-                         "clk_hz": CFG.clk_hz, "period": CFG.clk_hz // 1000, "efifo_log2": 0}
+                         "clk_hz": CFG.clk_hz, "period": CFG.clk_hz // 1000, "efifo_log2": 0,
+                         "engine": 0, "vel": "fx8"}
     assert len(run.rows) == CFG.snapshots
 
 
 def test_no_missed_snapshot(good):
     run, res = good
     assert not _fails(res, "snapshots")
-    assert run.misses == (0, 0, 0)
+    assert run.misses == (0, 0, 0, 0)
+
+
+def test_command_snapshot(good):
+    """enc_qei_drv_gsnap_take() after the timer stopped: every position the model's."""
+    run, res = good
+    assert run.gsnap and run.gsnap[0] == 0
+    assert not _fails(res, "gsnap")
 
 
 def test_positions_exact(good):
@@ -85,6 +99,49 @@ def test_handler_cycles_reported(good):
     means = [run.cycles[k][1] for k in sorted(run.cycles)]
     assert means == sorted(means)
     assert run.cycles[CFG.channels][2] < CFG.clk_hz // 1000   # the handler fits in the period
+
+
+def test_fixed_point_readings_held_to_one_unit(good):
+    """The check holds the fixed-point readings to one unit (2^-8 count/s) of the estimator on
+    the model's registers: a reading moved by 1.5 units fails it, one moved by 0.4 does not."""
+    run, res = good
+    assert check.resolution(run) == 2.0**-8
+    for du, ok in ((0.4, True), (1.5, False)):
+        r2 = copy.deepcopy(run)
+        i = len(r2.rows) // 2
+        n, t, lat, cyc, pos, vel = r2.rows[i]
+        vel = [v + du / 256 if k == 1 else v for k, v in enumerate(vel)]
+        r2.rows[i] = (n, t, lat, cyc, pos, vel)
+        assert check.check(CFG.motions(), r2, delay=res.delay).ok is ok, du
+
+
+@pytest.fixture(scope="module")
+def double():
+    return _run(vel="double")[:2]
+
+
+def test_double_estimator_build(double):
+    """The same firmware with the double estimator passes the same checks."""
+    run, res = double
+    assert run.build["vel"] == "double"
+    assert res.ok, res.failures
+
+
+def test_handler_goal_per_channel(good, double):
+    """The fixed point: at most 500 cycles a channel on average (snapshot read, position,
+    velocity, record), 16 channels at 1 kHz in 20 % of the CPU by the worst case; the double
+    estimator far slower."""
+    fx, db = cli.PerChannel.of(good[0]), cli.PerChannel.of(double[0])
+    period = CFG.clk_hz // 1000
+    assert fx.mean <= cli.GOAL_PER_CHANNEL, fx
+    assert fx.handler(cli.GOAL_CHANNELS) <= cli.GOAL_SHARE * period, fx
+    assert db.mean > 5 * fx.mean, (db, fx)
+
+
+def test_fixed_point_firmware_links_no_floating_point():
+    fw = simsoc.build_firmware(CFG)
+    assert simsoc.soft_float_symbols(fw) == []
+    assert "__divdf3" in simsoc.soft_float_symbols(simsoc.build_firmware(CFG, vel="double"))
 
 
 def test_wrong_page_fails_the_check():
@@ -119,6 +176,14 @@ def test_wrong_efifo_field_fails_the_check():
     run, res, fifo = _run("efifo", ECFG)
     assert run.done
     assert not fifo.ok and [m for w, m in fifo.failures if w == "efifo"], fifo.failures
+
+
+def test_shared_engine_build():
+    """The same firmware on the lean profile with the channels sharing one engine (CAPS.ENGINE =
+    shared): the driver's snapshots, positions and velocities pass every check there too."""
+    run, res, _ = _run(cfg=simsoc.ENGINE)
+    assert run.build["engine"] == 1 and run.build["profile"] == 3
+    assert res.ok, res.failures
 
 
 @pytest.mark.parametrize("which", ["main", "efifo"])

@@ -29,3 +29,11 @@ def c_driver(tmp_path_factory):
         return out
 
     return build
+
+
+@pytest.fixture(scope="session")
+def c_fixed(c_driver):
+    """The test driver that runs sw/enc_qei_velocity_fx.c (which it includes) and
+    sw/enc_qei_velocity.c side by side (tb/velocity/velfx_driver.c)."""
+    return c_driver("velfx_driver", [SW / "enc_qei_velocity.c",
+                                     Path(__file__).parent / "velfx_driver.c"])

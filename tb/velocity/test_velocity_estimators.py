@@ -8,6 +8,8 @@ edge types, several timebases (including TS_W = 16 with wraps) -- and must agree
 1e-12 (they do the same double operations in the same order, so in practice bit for bit).
 Rules: the standstill bound, the stall timeout, the reversal rule, period flags, timebase wrap at
 TS_W bits and count wrap at COUNT_W bits, each on hand-made snapshots through both versions.
+Every stream that goes through both() also goes through the fixed-point C
+(sw/enc_qei_velocity_fx.c), held to one unit of the double C (test_velocity_fixed.py).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,15 +26,24 @@ import pytest
 from hedsmodel import EncoderUnit, Profile
 from hedsmodel.velocity import (EstimatorConfig, Snapshot, Timebase, VelocityEstimator,
                                 counts_per_edge, edge_table, ideal_snapshots, to_rpm)
+from test_velocity_fixed import fixed_agrees
 
 TOP = Path(__file__).resolve().parents[2]
 SW = TOP / "sw"
 REL_TOL = 1e-12
 
 
+@dataclass(frozen=True)
+class CEstimators:
+    vel: Path   # vel_driver: sw/enc_qei_velocity.c
+    fx: Path    # velfx_driver: sw/enc_qei_velocity_fx.c beside it
+
+
 @pytest.fixture(scope="session")
-def c_estimator(c_driver):
-    return c_driver("vel_driver", [SW / "enc_qei_velocity.c", Path(__file__).parent / "vel_driver.c"])
+def c_estimator(c_driver, c_fixed):
+    return CEstimators(
+        c_driver("vel_driver", [SW / "enc_qei_velocity.c", Path(__file__).parent / "vel_driver.c"]),
+        c_fixed)
 
 
 def run_c(exe: Path, cfg: EstimatorConfig, snaps) -> list[tuple[float, float, float]]:
@@ -46,10 +58,12 @@ def run_c(exe: Path, cfg: EstimatorConfig, snaps) -> list[tuple[float, float, fl
     return [tuple(float(x) for x in ln.split()) for ln in res.stdout.splitlines()]
 
 
-def both(exe, cfg, snaps):
-    """Readings (m, t, mt) per snapshot from Python, after checking C agrees."""
+def both(exe: CEstimators, cfg, snaps):
+    """Readings (m, t, mt) per snapshot from Python, after checking that C agrees and that the
+    fixed-point C is within one unit of it (test_velocity_fixed.py)."""
     py = [(r.m, r.t, r.mt) for r in VelocityEstimator(cfg).run(snaps)]
-    c = run_c(exe, cfg, snaps)
+    c = run_c(exe.vel, cfg, snaps)
+    fixed_agrees(exe.fx, cfg, snaps)
     assert len(c) == len(py), f"C gave {len(c)} readings for {len(py)} snapshots"
     for i, (rp, rc) in enumerate(zip(py, c)):
         for name, a, b in zip(("M", "T", "MT"), rp, rc):
@@ -105,7 +119,7 @@ def test_c_and_python_agree_on_model_vectors(c_estimator, seed):
 
 
 def test_c_rejects_bad_config(c_estimator):
-    res = subprocess.run([str(c_estimator)], input="1e-8 40 32 1 0 0\n", capture_output=True,
+    res = subprocess.run([str(c_estimator.vel)], input="1e-8 40 32 1 0 0\n", capture_output=True,
                          text=True)
     assert res.returncode == 2 and "out of range" in res.stderr
 

@@ -6,11 +6,12 @@ row in doc/results/soc_bitstream.md.
 - ``icebreaker``: iCE40 UP5K. VexRiscv ``minimal`` (RV32I, no caches), one lean channel with a
   16-bit timebase on PMOD1A (A, B, Z), 64 KiB of SRAM in the SPRAM, an 8 KiB ROM of block RAM at
   12 MHz (two lean channels need 5,980 logic cells of the 5,280). The ROM holds no program:
-  sw/soc (about 14 KiB with printf and software doubles, and it reads mcycle, which ``minimal``
-  lacks) does not fit the UP5K's 15 KiB of block RAM; the row is the SoC's size and speed.
+  sw/soc (about 12.5 KiB with printf, and it reads mcycle, which ``minimal`` lacks) does not fit
+  the UP5K's 15 KiB of block RAM; the row is the SoC's size and speed.
 - ``colorlight_i5``: ECP5 LFE5U-25F. VexRiscv ``full``, 8 lean channels (A and B on the two PMODs
   of the extension board, no index), 16 KiB of ROM holding sw/soc, 64 KiB of SRAM, at 60 MHz
-  from the PLL (the 1 kHz handler needs about 6,600 cycles per channel).
+  from the PLL (the 1 kHz handler needs about 500 cycles per channel with the fixed-point
+  estimator, doc/results/soc_sim.md).
 
 The pins are the boards' (their published pinouts); no board is at hand here, so the bitstreams
 are built and measured, not run.

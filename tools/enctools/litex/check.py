@@ -10,9 +10,11 @@ compares them with ``motion``'s exact model:
   every channel and snapshot must match for one D; the check finds the D that do.
 - **Velocity, the estimator.** The model's own snapshot registers (count, times, deltas of the
   last A-rising edges) go through ``hedsmodel.velocity`` -- the same estimator as
-  sw/enc_qei_velocity.c -- and the firmware's reading must equal that to the printed 0.001
-  count/s. So the firmware read the right registers, and where the estimator's documented rules
-  read 0 (the first edge is a reference, a reversal, the stall timeout), it reads 0.
+  sw/enc_qei_velocity.c -- and the firmware's reading must equal that: to the printed 0.001
+  count/s for the double estimator, to one unit of its resolution (2^-F count/s, printed exactly)
+  for the fixed-point one (sw/enc_qei_velocity_fx.c, BUILD's ``fx<F>``). So the firmware read the
+  right registers, and where the estimator's documented rules read 0 (the first edge is a
+  reference, a reversal, the stall timeout), it reads 0 (exactly, in fixed point).
 - **Velocity, the physics.** Every reading that is not such a 0 must be within the bound
       |v_read - v(t)| <= |v_read| * tick / (dT - tick) + a_max * (t - t_mid) + 0.0005
   of the true speed v(t) at the snapshot: the reading is the counts between two A-rising edges
@@ -20,10 +22,13 @@ compares them with ``motion``'s exact model:
   one tick); it is the mean speed over that interval, which is the speed at its midpoint t_mid
   when the acceleration is constant, and the speed moves by at most a_max (the largest
   |acceleration| from the first edge to the snapshot) per second after that; 0.0005 count/s is
-  the printing. In a constant-speed stretch the bound is the timebase term alone, the benchmark's
-  "one tick over the time between the two timestamps" (doc/velocity.md).
+  the printing (2^-F count/s, the resolution, for the fixed point). In a constant-speed stretch
+  the bound is the timebase term alone, the benchmark's "one tick over the time between the two
+  timestamps" (doc/velocity.md).
 - **No missed snapshot**: consecutive GSNAP_TIMEs are one GSNAP_PERIOD apart, and the firmware
-  counted no miss, no torn read and no skewed SNAP_TIME.
+  counted no miss, no torn read, no skewed SNAP_TIME and no failed driver call.
+- **The command snapshot** (G line: enc_qei_drv_gsnap_take after the timer stopped): the driver
+  returned 0 and every position is the model's at its GSNAP_TIME, with the same D.
 - **Index and errors**: each INDEX_LATCH (read at the end, while the motion goes on) is a count
   at an index position of the model, and the QERR and GLITCH counters are 0.
 
@@ -54,9 +59,12 @@ EFIFO_FIELDS = ("k", "entries", "net", "dir_changes", "idx", "lost", "nonmono", 
 class Run:
     build: dict = field(default_factory=dict)
     rows: list = field(default_factory=list)      # (n, T, latency, cycles, [pos], [vel])
-    cycles: dict = field(default_factory=dict)    # k -> (min, mean, max)
+    cycles: dict = field(default_factory=dict)    # k -> (min, mean, max) up to channel k - 1 done
+    own: dict = field(default_factory=dict)       # k -> (min, mean, max) of channel k - 1 alone
+    fixed_part: tuple = ()                        # (min, mean, max) before the first channel
     ends: dict = field(default_factory=dict)      # k -> (count, index_latch, qerr, glitch)
-    misses: tuple = (None, None, None)
+    misses: tuple = (None, None, None, None)      # missed, torn, skewed, driver errors
+    gsnap: tuple = ()                             # the G line: (err, time, [pos])
     efifo: dict = field(default_factory=dict)     # k -> {name: value} of its E line
     unmapped: dict = field(default_factory=dict)  # the U line: offset, value, cycles, bus_errors
     done: bool = False
@@ -69,9 +77,10 @@ def parse(console: str) -> Run:
         f = line.split()
         if not f:
             continue
-        if f[0] == "BUILD" and len(f) == 8:
+        if f[0] == "BUILD" and len(f) == 10:
             r.build = dict(zip(("channels", "profile", "count_w", "ts_w", "clk_hz", "period",
-                                "efifo_log2"), map(int, f[1:])))
+                                "efifo_log2", "engine"), map(int, f[1:9])))
+            r.build["vel"] = f[9]                 # "double" or "fx<F>"
         elif f[0] == "S":
             v = [x for x in f[1:] if x != "|"]
             n, t, lat, cyc = (int(x) for x in v[:4])
@@ -81,9 +90,15 @@ def parse(console: str) -> Run:
             r.table.append(line)
         elif f[0] == "C" and len(f) == 5:
             r.cycles[int(f[1])] = tuple(int(x) for x in f[2:])
+        elif f[0] == "D" and len(f) == 5:
+            r.own[int(f[1])] = tuple(int(x) for x in f[2:])
+        elif f[0] == "F" and len(f) == 4:
+            r.fixed_part = tuple(int(x) for x in f[1:])
+        elif f[0] == "G" and len(f) >= 3:
+            r.gsnap = (int(f[1]), int(f[2]), [int(x) for x in f[3:]])
         elif f[0] == "X" and len(f) == 6:
             r.ends[int(f[1])] = tuple(int(x) for x in f[2:])
-        elif f[0] == "M" and len(f) == 4:
+        elif f[0] == "M" and len(f) == 5:
             r.misses = tuple(int(x) for x in f[1:])
         elif f[0] == "E" and len(f) == 1 + len(EFIFO_FIELDS):
             r.efifo[int(f[1])] = dict(zip(EFIFO_FIELDS[1:], map(int, f[2:])))
@@ -95,6 +110,12 @@ def parse(console: str) -> Run:
         elif line.lstrip().startswith("snap "):
             r.table.append(line)
     return r
+
+
+def resolution(run: Run) -> float | None:
+    """The fixed-point firmware's unit, 2^-F count/s (None: the double estimator)."""
+    vel = run.build.get("vel", "double")
+    return 2.0 ** -int(vel[2:]) if vel.startswith("fx") else None
 
 
 @dataclass
@@ -166,7 +187,7 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
     position (the edge FIFO's, which its entries' times pin to the clock); without it, or when
     it does not fit, the middle one of those that fit."""
     fails: list[tuple[str, str]] = []   # (what, message); what: finish, snapshots, positions,
-                                        # velocity or index
+                                        # gsnap, velocity or index
 
     def fail(what: str, msg: str) -> None:
         fails.append((what, msg))
@@ -189,8 +210,9 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
                           f"{sorted(set(gaps))}")
     if [r[0] for r in run.rows] != list(range(len(run.rows))):
         fail("snapshots", "snapshot numbers are not consecutive")
-    if run.misses != (0, 0, 0):
-        fail("snapshots", f"firmware counted missed/torn/skewed snapshots {run.misses}")
+    if run.misses != (0, 0, 0, 0):
+        fail("snapshots", f"firmware counted missed/torn/skewed snapshots and driver errors "
+                          f"{run.misses}")
 
     # positions: one delay D for all
     delays = [d for d in range(0, 64)
@@ -205,9 +227,28 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
                          f"{chans[k].count(times[bad[0]] - best)})")
     d = delay if delay in delays else delays[len(delays) // 2] if delays else None
 
+    # the command snapshot at the end
+    if not run.gsnap:
+        fail("gsnap", "no G line (the command snapshot)")
+    else:
+        err, tg, gpos = run.gsnap
+        if err != 0 or len(gpos) != nch:
+            fail("gsnap", f"enc_qei_drv_gsnap_take returned {err} with {len(gpos)} positions")
+        elif d is not None:
+            n = max(n, tg + 10)
+            chans = [Channel(motions[k], n) for k in range(nch)]
+            want = [int(chans[k].count(tg - d)) for k in range(nch)]
+            if gpos != want:
+                fail("gsnap", f"the command snapshot at {tg}: positions {gpos}, the model's "
+                              f"{want} (D = {d})")
+
     nvel = nbound = nzero = 0
     offsets: set[int] = set()
     worst = worst_const = 0.0
+    unit = resolution(run)
+    tol = unit + 1e-9 if unit else 0.0015      # one unit of the fixed point; the printing
+    slack = unit if unit else 0.0005           # the same, in the error bound
+    dev = 0.0                                  # the largest |reading - estimator|
     if d is not None:
         stall = int(round(clk * stall_ms / 1000))
         for k, ch in enumerate(chans):
@@ -216,16 +257,18 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
             cands = {}
             for off in (0, -1, 1, -2, 2):
                 ref, pairs = _ref_readings(ch, times, d, clk, off, stall)
-                cands[off] = (int(np.sum(np.abs(ref - vel[:, k]) > 0.0015)), ref, pairs)
+                off_by = (np.abs(ref - vel[:, k]) > tol) | ((ref == 0.0) & (vel[:, k] != 0.0))
+                cands[off] = (int(np.sum(off_by)), ref, pairs, off_by)
             off = min(cands, key=lambda o: cands[o][0])
             offsets.add(off)
-            nbad, ref, pairs = cands[off]
+            nbad, ref, pairs, off_by = cands[off]
             nvel += len(ref)
+            dev = max(dev, float(np.max(np.abs(ref - vel[:, k]))))
             if nbad:
-                i = int(np.flatnonzero(np.abs(ref - vel[:, k]) > 0.0015)[0])
+                i = int(np.flatnonzero(off_by)[0])
                 fail("velocity", f"channel {k}: {nbad} velocity readings differ from the estimator "
-                             f"on the model's registers (first: snapshot {i}, read {vel[i, k]}, "
-                             f"expected {ref[i]:.3f})")
+                             f"on the model's registers by more than {tol:g} count/s (first: "
+                             f"snapshot {i}, read {vel[i, k]}, expected {ref[i]:.8f})")
             for i, T in enumerate(times):
                 t = int(T - d)
                 v_true = ch.vel[t] * clk / 2 ** motion.FRAC
@@ -238,7 +281,7 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
                 t1, t2 = pairs[i]
                 a_max = float(np.max(np.abs(ch.acc[t1:t + 1]))) * clk * clk / 2 ** motion.VFRAC
                 bound = (abs(v_read) / (t2 - t1 - 1) + a_max * (t - (t1 + t2) / 2 + 1) / clk
-                         + 0.0005)
+                         + slack)
                 err = abs(v_read - v_true)
                 nbound += 1
                 worst = max(worst, err / bound)
@@ -263,16 +306,23 @@ def check(motions: list[motion.Motion], run: Run, stall_ms: float = 20.0,
         if not crossed and latch != 0:
             fail("index", f"channel {k}: INDEX_LATCH {latch} without an index")
 
+    if unit:
+        kind = f"fixed point, 2^-{run.build['vel'][2:]} count/s"
+        equal = f"within one unit (largest difference {dev / unit:.3f} unit)"
+    else:
+        kind, equal = "double", "to the printed 0.001 count/s"
+    gsnap_ok = run.gsnap and not [m for w, m in fails if w == "gsnap"]
     summary = [
         f"{len(times)} snapshots x {nch} channels: positions exact for delay D = {d} "
         f"(D consistent with every position: {delays[0] if delays else '-'}.."
         f"{delays[-1] if delays else '-'} clocks)",
-        f"velocity: {nvel} readings equal the estimator on the model's registers (edge "
-        f"timestamps {sorted(offsets)} clocks from the count's step); {nzero} are its documented "
-        f"0; {nbound} within the bound (worst error/bound {worst:.6f}; {worst_const:.6f} at "
-        f"constant speed)",
-        f"snapshots: gaps {sorted(set(int(g) for g in gaps))} ticks, missed/torn/skewed "
-        f"{run.misses}",
+        f"velocity ({kind}): {nvel} readings equal the estimator on the model's registers "
+        f"{equal} (edge timestamps {sorted(offsets)} clocks from the count's step); {nzero} are "
+        f"its documented 0; {nbound} within the bound (worst error/bound {worst:.6f}; "
+        f"{worst_const:.6f} at constant speed)",
+        f"snapshots: gaps {sorted(set(int(g) for g in gaps))} ticks, missed/torn/skewed/driver "
+        f"errors {run.misses}; the command snapshot (enc_qei_drv_gsnap_take) "
+        f"{'equals the model' if gsnap_ok else 'FAILS'}",
     ]
     return Result(not fails, fails, delays, d, len(times) * nch, nvel, nbound, nzero, worst,
                   worst_const, summary)

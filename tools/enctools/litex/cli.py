@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
-"""``make soc-sim``: build the simulated LiteX SoCs with enc_qei (simsoc.MAIN, and simsoc.EFIFO
-with an edge FIFO per channel), run their firmware, print the UART tables, check them against the
-motion model, run the deliberately wrong firmware and check that the checks fail, and write
-doc/results/soc_sim.md. The pytest module tb/soc/test_soc_sim.py asserts the same on the same
-(cached) runs."""
+"""``make soc-sim``: build the simulated LiteX SoCs with enc_qei (simsoc.MAIN, simsoc.EFIFO
+with an edge FIFO per channel, simsoc.ENGINE with the channels sharing one engine), run their
+firmware (on MAIN twice: with the fixed-point and with the double velocity estimator), print the UART tables, check them against the motion model, run
+the deliberately wrong firmware and check that the checks fail, and write doc/results/soc_sim.md
+(the handler's cycles of both estimators). The pytest module tb/soc/test_soc_sim.py asserts the
+same on the same (cached) runs."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import dataclasses
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 
 from ..paths import RESULTS, rel
 from . import check, simsoc
@@ -19,18 +21,17 @@ from . import check, simsoc
 RESULT_FILE = RESULTS / "soc_sim.md"
 FAULTS = {"page": "channel k's SNAP_COUNT read from the page of channel k + 1",
           "efifo": "an edge-FIFO entry's direction read from its A bit instead of DIR"}
-# the builds, each with the deliberately wrong firmware its checks must catch
-BUILDS = {"main": (simsoc.MAIN, "page"), "efifo": (simsoc.EFIFO, "efifo")}
 
 
-def run_firmware(cfg: simsoc.SocConfig, fault: str | None = None):
-    """Build the firmware (``fault``: the deliberately wrong one), run it, check it:
-    (console, seconds, parsed run, check result, edge-FIFO check result or None)."""
-    fw = simsoc.build_firmware(cfg, fault)
+def run_firmware(cfg: simsoc.SocConfig, fault: str | None = None, vel: str = "fixed"):
+    """Build the firmware (``fault``: the deliberately wrong one; ``vel``: its velocity
+    estimator), run it, check it: (console, seconds, parsed run, check result, edge-FIFO check
+    result or None, the soft-float routines it links)."""
+    fw = simsoc.build_firmware(cfg, fault, vel)
     out, dt = simsoc.run(cfg, fw)
     run = check.parse(out)
     res, fifo = check.check_run(cfg.motions(), run)
-    return out, dt, run, res, fifo
+    return out, dt, run, res, fifo, simsoc.soft_float_symbols(fw)
 
 
 def verdict(res: check.Result, fifo: check.EfifoResult | None) -> tuple[bool, list]:
@@ -40,26 +41,38 @@ def verdict(res: check.Result, fifo: check.EfifoResult | None) -> tuple[bool, li
 
 
 def cycles_table(run: check.Run) -> list[str]:
-    clk, period = run.build["clk_hz"], run.build["period"]
-    rows = ["| channels read | cycles min | mean | max | mean added by the channel | "
-            "max / period |", "|---:|---:|---:|---:|---:|---:|"]
-    prev = 0
+    period = run.build["period"]
+    rows = ["| channels read | cycles min | mean | max | the channel's own: min | mean | max | "
+            "max / period |", "|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for k in sorted(run.cycles):
         lo, mean, hi = run.cycles[k]
-        rows.append(f"| {k} | {lo} | {mean} | {hi} | {mean - prev} | {100 * hi / period:.1f} % |")
-        prev = mean
-    k = max(run.cycles)
-    per_mean, per_max = run.cycles[k][1] / k, run.cycles[k][2] / k
-    lat = [r[2] for r in run.rows[1:]]
-    return rows + [
-        "",
-        f"Per channel about {per_mean:.0f} cycles on average and {per_max:.0f} at most (the "
-        f"handler's fixed part, IRQ_SUMMARY, EVENTS and GSNAP_TIME, is in the first row). At "
-        f"{clk / 1e6:g} MHz and 1 kHz the period is {period} cycles: by the worst case "
-        f"{int(period // per_max)} channels fit in it this way. Interrupt latency, from the "
-        f"snapshot to the handler's first instructions (TIMEBASE there minus GSNAP_TIME: the "
-        f"trap entry and LiteX's dispatch): {min(lat)} to {max(lat)} clocks.",
-    ]
+        olo, omean, ohi = run.own.get(k, (0, 0, 0))
+        rows.append(f"| {k} | {lo} | {mean} | {hi} | {olo} | {omean} | {ohi} | "
+                    f"{100 * hi / period:.1f} % |")
+    return rows
+
+
+@dataclass
+class PerChannel:
+    """Handler cycles per channel of one run (snapshot read, velocity, record)."""
+    mean: float        # (cycles to the last channel - the fixed part) / channels, means
+    worst: float       # the same for the slowest snapshot (its total, the fixed part's minimum)
+    fixed_max: int     # the handler's fixed part (TIMEBASE, IRQ_SUMMARY, EVENTS), at most
+
+    @classmethod
+    def of(cls, run: check.Run) -> PerChannel:
+        n = max(run.cycles)
+        return cls((run.cycles[n][1] - run.fixed_part[1]) / n,
+                   (run.cycles[n][2] - run.fixed_part[0]) / n, run.fixed_part[2])
+
+    def handler(self, channels: int) -> float:
+        """A handler for ``channels`` channels by the worst case: its fixed part and the
+        slowest per-channel cost."""
+        return self.fixed_max + channels * self.worst
+
+
+GOAL_PER_CHANNEL = 500      # cycles a channel, snapshot read plus velocity
+GOAL_CHANNELS, GOAL_SHARE = 16, 0.20   # 16 channels at 1 kHz in 20 % of the CPU
 
 
 def fault_row(fault: str, fails: list) -> str:
@@ -78,43 +91,131 @@ def unmapped_line(run: check.Run) -> str:
             f"{u['bus_errors']} bus error")
 
 
+def handler_section(fixed: check.Run, double: check.Run, fixed_sf: list,
+                    double_sf: list) -> list[str]:
+    """The handler-cycles section of the results: both estimators' tables and what they mean.
+    ``*_sf``: the soft-float routines each firmware links."""
+    clk, period = fixed.build["clk_hz"], fixed.build["period"]
+    fx, db = PerChannel.of(fixed), PerChannel.of(double)
+    n16 = fx.handler(GOAL_CHANNELS)
+    lat = [r[2] for r in fixed.rows[1:]]
+    # the slowest snapshots of the fixed point, per channel (the S lines: the handler's cycles)
+    nch = max(fixed.cycles)
+    slow = sorted(((r[3] - fixed.fixed_part[0]) / nch, r[0]) for r in fixed.rows[1:])[-2:]
+    goal = (f"met on average ({fx.mean:.0f}) and in the slowest snapshot ({fx.worst:.0f})"
+            if fx.worst <= GOAL_PER_CHANNEL else
+            f"met on average ({fx.mean:.0f}); the slowest snapshot, {slow[-1][1]}, takes "
+            f"{slow[-1][0]:.0f} a channel, the next slowest ({slow[0][1]}) {slow[0][0]:.0f}"
+            if fx.mean <= GOAL_PER_CHANNEL else f"MISSED ({fx.mean:.0f} on average)")
+
+    def fixed_part(run: check.Run) -> str:
+        lo, _, hi = run.fixed_part
+        return f"{lo} cycles" if lo == hi else f"{lo} to {hi} cycles"
+    floats = ("none of compiler-rt's soft-float routines" if not fixed_sf
+              else "soft-float routines: " + ", ".join(fixed_sf))
+    return [
+        "## Handler cycles per snapshot versus channels read",
+        "",
+        "CPU cycles (mcycle) from the handler's first instructions until channel k − 1 is done "
+        "(its snapshot read through the driver: wait for its SNAP_READY, clear it and see it "
+        "clear, five snapshot registers; its position and velocity; its record), over the "
+        "snapshots after the first (which only initialises the estimators); *the channel's own* "
+        "counts from the end of the channel before (for the first, from the end of the "
+        "handler's fixed part: TIMEBASE, IRQ_SUMMARY, EVENTS). The trap entry and LiteX's "
+        "interrupt dispatch before the handler are the latency below. Two builds of the same "
+        "firmware that differ only in the velocity estimator, measured the same way:",
+        "",
+        f"**Fixed point** (the default): `qei_velfx_update_mt()` (`sw/enc_qei_velocity_fx.c`), "
+        f"the timestamp method in integers, readings in 2^-{fixed.build['vel'][2:]} count/s. "
+        f"The handler's fixed part takes {fixed_part(fixed)}.",
+        "",
+        *cycles_table(fixed),
+        "",
+        f"**Double** (`FW_VEL=double`): `qei_vel_update()` (`sw/enc_qei_velocity.c`), all three "
+        f"methods in double precision, which this CPU (no FPU) runs in compiler-rt's software "
+        f"floating point. The handler's fixed part takes {fixed_part(double)}.",
+        "",
+        *cycles_table(double),
+        "",
+        f"- Per channel (snapshot read, position, velocity, record): fixed point {fx.mean:.0f} "
+        f"cycles on average and {fx.worst:.0f} in the slowest snapshot; double {db.mean:.0f} and "
+        f"{db.worst:.0f}: {db.mean / fx.mean:.1f} times as many on average.",
+        f"- Goal at most {GOAL_PER_CHANNEL} cycles a channel, by the fixed point: {goal}.",
+        f"- {GOAL_CHANNELS} channels at 1 kHz by the worst case (the fixed part at its longest, "
+        f"every channel at its slowest): fixed point {n16:,.0f} cycles of the {period:,} in a "
+        f"period at {clk / 1e6:g} MHz, {100 * n16 / period:.1f} % (goal "
+        f"{100 * GOAL_SHARE:.0f} %; the trap entry and dispatch add about the latency below); "
+        f"double {db.handler(GOAL_CHANNELS):,.0f} cycles, "
+        f"{100 * db.handler(GOAL_CHANNELS) / period:.0f} %: it fits "
+        f"{int((period - db.fixed_max) // db.worst)} channels in the whole period.",
+        f"- Interrupt latency, from the snapshot to the handler's first instructions (TIMEBASE "
+        f"there minus GSNAP_TIME: the trap entry and LiteX's dispatch): {min(lat)} to {max(lat)} "
+        f"clocks.",
+        f"- Floating point: the fixed-point firmware links {floats} (`nm firmware.elf`); the "
+        f"double one links {len(double_sf)} ({', '.join(double_sf)}).",
+    ]
+
+
+def engine_section(result) -> list[str]:
+    cfg, run, res, _, _, _ = result
+    b, pc = run.build, PerChannel.of(run)
+    return [
+        "## The shared-engine build",
+        "",
+        f"The same SoC and firmware (fixed point) with the lean profile and the channels sharing "
+        f"one engine (`engine=1`: CAPS.PROFILE = {b['profile']}, CAPS.ENGINE = {b['engine']}, "
+        f"{b['channels']} channels, the four motions), which may show a write's effect, a snapshot "
+        "and a count step some clocks later: the driver waits for each channel's SNAP_READY and "
+        "never reads a written register back.",
+        "",
+        *[f"- {s}" for s in res.summary],
+        f"- handler: {pc.mean:.0f} cycles a channel on average, {pc.worst:.0f} in the slowest "
+        f"snapshot (the fixed part {run.fixed_part[0]} to {run.fixed_part[2]})",
+        f"- result: {'pass' if res.ok else 'FAIL'}"
+        + ("" if res.ok else ": " + "; ".join(m for _, m in res.failures[:3])),
+        "",
+    ]
+
+
 def write_results(results: dict) -> None:
-    """results: build name (BUILDS) -> (config, run, check result, edge-FIFO result or None,
-    fault -> its failures)."""
-    _, run, res, _, fault_fails = results["main"]
+    """results: run name (RUNS) -> (config, run, check result, edge-FIFO result or None,
+    fault -> its failures, soft-float routines)."""
+    _, run, res, _, fault_fails, sf = results["main"]
+    _, drun, dres, _, _, dsf = results["main_double"]
     b = run.build
     lines = [
         "<!-- written by scripts/soc_sim.py (make soc-sim); do not edit by hand -->",
         "",
         "# enc_qei in a simulated LiteX SoC: the firmware's figures",
         "",
-        f"LiteX SoC in Verilator: VexRiscv (`full` variant, RV32IM, no FPU) at a declared "
-        f"{b['clk_hz'] / 1e6:g} MHz, integrated ROM (the firmware) and SRAM, `enc_qei_wb` with "
-        f"CAPS.CHANNELS = {b['channels']}, CAPS.PROFILE = {b['profile']} (full), COUNT_W "
-        f"{b['count_w']}, TS_W {b['ts_w']}, TB_PRESCALE 0 (one tick per clock). The global unit "
-        f"timer takes a snapshot of every channel each {b['period']} ticks (1 kHz); the interrupt "
-        f"handler of `sw/soc/main.c` reads each channel's snapshot registers and runs "
-        f"`qei_vel_update()` (`sw/enc_qei_velocity.c`, double precision in software). "
-        f"{len(run.rows)} snapshots; the encoder inputs are the motions of "
+        f"LiteX SoC in Verilator: VexRiscv (`full` variant, RV32IM, no FPU, 4 KiB instruction "
+        f"and data caches) at a declared {b['clk_hz'] / 1e6:g} MHz, integrated ROM (the firmware) "
+        f"and SRAM, `enc_qei_wb` with CAPS.CHANNELS = {b['channels']}, CAPS.PROFILE = "
+        f"{b['profile']} (full), COUNT_W {b['count_w']}, TS_W {b['ts_w']}, TB_PRESCALE 0 (one "
+        f"tick per clock). The global unit timer takes a snapshot of every channel each "
+        f"{b['period']} ticks (1 kHz); the interrupt handler of `sw/soc/main.c` reads each "
+        f"channel's part of it through the driver API (`sw/enc_qei_drv.c`) and computes its "
+        f"velocity. {len(run.rows)} snapshots; the encoder inputs are the motions of "
         f"`tools/enctools/litex/motion.py` (doc/litex.md).",
         "",
-        "## Handler cycles per snapshot versus channels read",
-        "",
-        "CPU cycles (mcycle) from the handler's first instructions until channel k − 1 is done "
-        "(its registers read, `qei_vel_update()` run, the record stored), over the snapshots "
-        "after the first (which only initialises the estimators); the trap entry and LiteX's "
-        "interrupt dispatch before the handler are the latency below.",
-        "",
-        *cycles_table(run),
+        *handler_section(run, drun, sf, dsf),
         "",
         "## Checks against the motion model",
+        "",
+        "The fixed-point firmware:",
         "",
         *[f"- {s}" for s in res.summary],
         f"- result: {'pass' if res.ok else 'FAIL'}"
         + ("" if res.ok else ": " + "; ".join(m for _, m in res.failures[:3])),
         "",
+        "The double firmware:",
+        "",
+        *[f"- {s}" for s in dres.summary],
+        f"- result: {'pass' if dres.ok else 'FAIL'}"
+        + ("" if dres.ok else ": " + "; ".join(m for _, m in dres.failures[:3])),
+        "",
     ]
-    ecfg, erun, eres, efifo, efault_fails = results["efifo"]
+    ecfg, erun, eres, efifo, efault_fails, _ = results["efifo"]
     ok, fails = verdict(eres, efifo)
     eb = erun.build
     lines += [
@@ -123,9 +224,9 @@ def write_results(results: dict) -> None:
         f"The same SoC with CAPS.CHANNELS = {eb['channels']}, an edge FIFO of "
         f"{1 << eb['efifo_log2']} entries per channel (EFIFO_LOG2 {eb['efifo_log2']}) and the "
         f"motions {', '.join(m.name for m in ecfg.motions())} (the steady channel's 3.1 million "
-        "steps per second is left out: see the cost per entry below). The same firmware finds "
-        "the FIFO in CAPS, clears and enables it, and drains every channel's FIFO in its main "
-        "loop between the snapshot interrupts; at the end it turns the FIFOs off "
+        "steps per second is left out: see the cost per entry below). The same firmware (fixed "
+        "point) finds the FIFO in CAPS, clears and enables it, and drains every channel's FIFO "
+        "in its main loop between the snapshot interrupts; at the end it turns the FIFOs off "
         "(EFIFO_CTRL.EN = 0), drains what is left and prints, per channel, the statistics of "
         "every entry it popped.",
         "",
@@ -139,6 +240,7 @@ def write_results(results: dict) -> None:
         else "- draining: no entries",
         f"- result: {'pass' if ok else 'FAIL'}" + ("" if ok else ": " + "; ".join(m for _, m in fails[:3])),
         "",
+        *engine_section(results["engine"]),
         "## Deliberately wrong firmware",
         "",
         "| build flag | fault | the check |",
@@ -156,6 +258,11 @@ def write_results(results: dict) -> None:
     RESULT_FILE.write_text("\n".join(lines) + "\n")
 
 
+# the runs: name -> (build, deliberately wrong firmware its checks must catch, estimator)
+RUNS = {"main": (simsoc.MAIN, "page", "fixed"), "main_double": (simsoc.MAIN, None, "double"),
+        "efifo": (simsoc.EFIFO, "efifo", "fixed"), "engine": (simsoc.ENGINE, None, "fixed")}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="soc_sim.py", description=__doc__)
     ap.add_argument("--snapshots", type=int, default=simsoc.SocConfig.snapshots)
@@ -164,33 +271,44 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.snapshots < 3:
         ap.error(f"--snapshots {args.snapshots}: give at least 3 (the first only initialises)")
-    builds = {name: (dataclasses.replace(cfg, snapshots=args.snapshots), fault)
-              for name, (cfg, fault) in BUILDS.items()}
+    runs = {name: (dataclasses.replace(cfg, snapshots=args.snapshots), fault, vel)
+            for name, (cfg, fault, vel) in RUNS.items()}
     t0 = time.monotonic()
-    for cfg, _ in builds.values():
+    for cfg in {cfg for cfg, _, _ in runs.values()}:
         simsoc.build_gateware(cfg, force=args.rebuild)
-    # the good firmware and the wrong ones of both builds, two at a time (a simulator each)
+    # the good firmware of every run and the wrong ones, two at a time (a simulator each)
     with ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = {(cfg, f): pool.submit(run_firmware, cfg, f)
-                for cfg, fault in builds.values() for f in (None, fault)}
+        jobs = {(name, f): pool.submit(run_firmware, cfg, f, vel)
+                for name, (cfg, fault, vel) in runs.items()
+                for f in ((None, fault) if fault else (None,))}
     ok_all, results = True, {}
-    for name, (cfg, fault) in builds.items():
-        out, dt, run, res, fifo = jobs[(cfg, None)].result()
+    for name, (cfg, fault, vel) in runs.items():
+        out, dt, run, res, fifo, sf = jobs[(name, None)].result()
+        tag = f"{cfg.tag} ({vel})"
         print("\n".join(line for line in out.replace("\r", "").splitlines()
                         if line.strip() and not line.startswith(("[", "-", "%"))))
-        print(f"soc-sim: {cfg.tag}: firmware run {dt:.1f} s" if dt else
-              f"soc-sim: {cfg.tag}: firmware run reused (cached)")
+        print(f"soc-sim: {tag}: firmware run {dt:.1f} s" if dt else
+              f"soc-sim: {tag}: firmware run reused (cached)")
         for s in res.summary + (fifo.summary if fifo else []):
-            print(f"soc-sim: {cfg.tag}: {s}")
+            print(f"soc-sim: {tag}: {s}")
         ok, fails = verdict(res, fifo)
+        if vel == "fixed" and sf:
+            ok, fails = False, fails + [("float", f"the fixed-point firmware links {sf}")]
         for _, m in fails:
-            print(f"soc-sim: {cfg.tag}: FAIL: {m}")
-        fres = jobs[(cfg, fault)].result()
-        fok, ffails = verdict(fres[3], fres[4])
-        print(f"soc-sim: {cfg.tag}: FW_FAULT={fault} ({FAULTS[fault]}): the check "
-              + ("PASSES: it missed the fault" if fok else f"fails as it must: {ffails[0][1]}"))
-        ok_all &= ok and not fok and run.done
-        results[name] = (cfg, run, res, fifo, {fault: ffails})
+            print(f"soc-sim: {tag}: FAIL: {m}")
+        ffails = []
+        if fault:
+            fres = jobs[(name, fault)].result()
+            fok, ffails = verdict(fres[3], fres[4])
+            print(f"soc-sim: {tag}: FW_FAULT={fault} ({FAULTS[fault]}): the check "
+                  + ("PASSES: it missed the fault" if fok else f"fails as it must: {ffails[0][1]}"))
+            ok = ok and not fok
+        ok_all &= ok and run.done
+        results[name] = (cfg, run, res, fifo, {fault: ffails} if fault else {}, sf)
+    if results["main"][1].done and results["main_double"][1].done:
+        fx, db = PerChannel.of(results["main"][1]), PerChannel.of(results["main_double"][1])
+        print(f"soc-sim: handler cycles per channel: fixed point {fx.mean:.0f} mean, "
+              f"{fx.worst:.0f} worst; double {db.mean:.0f} mean, {db.worst:.0f} worst")
     if not args.no_results and all(r[1].done for r in results.values()):
         write_results(results)
         print(f"soc-sim: wrote {rel(RESULT_FILE)}")

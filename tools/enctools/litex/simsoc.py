@@ -13,7 +13,8 @@ Three steps, each cached:
   from ``sim_rom.init`` when the simulation starts, so a new firmware needs no new simulator.
   Skipped when the inputs (the IP's Verilog, this package, the configuration, the tool versions)
   are those of the last build.
-- ``build_firmware(cfg, fault)``: ``make`` of sw/soc against that build.
+- ``build_firmware(cfg, fault, vel)``: ``make`` of sw/soc against that build (``vel``: the
+  fixed-point or the double velocity estimator).
 - ``run(cfg, firmware)``: a folder per firmware with the simulator's files and the firmware as
   ``sim_rom.init``; the simulator runs until the firmware ends it. The console output is kept,
   and reused while the simulator and the firmware are unchanged.
@@ -50,11 +51,14 @@ class SocConfig:
     snapshots: int = 100         # global snapshots the firmware records (one per ms)
     opt_level: str = "O3"        # C++ optimisation of the Verilated model
     efifo_log2: int = 0          # the edge FIFO of every channel: 2^efifo_log2 entries, 0 none
+    engine: int = 0              # 1: the channels share one engine (lean profile only)
     motion_names: tuple = ()     # the channels' motions by name (motion.profiles); () all four
 
     @property
     def tag(self) -> str:
-        return f"ch{self.channels}_{self.profile}" + (f"_efifo{self.efifo_log2}" if self.efifo_log2 else "")
+        return (f"ch{self.channels}_{self.profile}"
+                + (f"_efifo{self.efifo_log2}" if self.efifo_log2 else "")
+                + ("_engine" if self.engine else ""))
 
     @property
     def out(self) -> Path:
@@ -73,6 +77,7 @@ class SocConfig:
 # second, which no firmware on this CPU could drain: doc/litex.md)
 MAIN = SocConfig()
 EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
+ENGINE = SocConfig(profile="lean", engine=1)
 
 
 def _log(msg: str) -> None:
@@ -112,7 +117,7 @@ def make_soc(cfg: SocConfig):
                 integrated_sram_size=SRAM_SIZE, uart_name="sim")
             self.motion = motion.MotionGen(cfg.motions()).module()
             add_enc_qei(self, name="enc_qei", pads=self.motion, channels=cfg.channels,
-                        profile=cfg.profile, efifo_log2=cfg.efifo_log2)
+                        profile=cfg.profile, efifo_log2=cfg.efifo_log2, engine=cfg.engine)
             self.sim_finish = SimFinish()
 
     return EncSimSoC()
@@ -222,18 +227,41 @@ def build_gateware(cfg: SocConfig, force: bool = False) -> float:
     return dt
 
 
-def build_firmware(cfg: SocConfig, fault: str | None = None) -> Path:
-    """make sw/soc against the build; returns firmware.bin (in firmware/ or firmware_<fault>/)."""
-    fw_dir = cfg.out / (f"firmware_{fault}" if fault else "firmware")
+VELOCITY = ("fixed", "double")   # the firmware's estimator (sw/soc/Makefile's FW_VEL)
+
+
+def build_firmware(cfg: SocConfig, fault: str | None = None, vel: str = "fixed") -> Path:
+    """make sw/soc against the build; returns firmware.bin (in firmware/, firmware_<fault>/,
+    firmware_double/ ...). ``vel``: the velocity estimator, "fixed" (the default) or "double"."""
+    if vel not in VELOCITY:
+        raise ValueError(f"vel={vel!r}: give one of {VELOCITY}")
+    name = "firmware" + (f"_{fault}" if fault else "") + ("" if vel == "fixed" else f"_{vel}")
+    fw_dir = cfg.out / name
     fw_dir.mkdir(parents=True, exist_ok=True)
     args = ["make", "-s", "-C", str(fw_dir), "-f", str(FIRMWARE_SRC / "Makefile"),
-            f"BUILD_DIR={cfg.out}", f"FW_SNAPSHOTS={cfg.snapshots}"]
+            f"BUILD_DIR={cfg.out}", f"FW_SNAPSHOTS={cfg.snapshots}", f"FW_VEL={vel}"]
     if fault:
         args.append(f"FW_FAULT={fault}")
     r = subprocess.run(args, capture_output=True, text=True)
     if r.returncode != 0:
         raise SystemExit(f"soc-sim: firmware build failed:\n{r.stdout}{r.stderr}")
     return fw_dir / "firmware.bin"
+
+
+SOFT_FLOAT = ("__adddf3", "__subdf3", "__muldf3", "__divdf3", "__floatsidf", "__floatunsidf",
+              "__floatdidf", "__fixdfsi", "__fixdfdi", "__fixunsdfsi", "__fixunsdfdi", "__cmpdf2",
+              "__ledf2", "__gedf2", "__addsf3", "__mulsf3", "__divsf3")
+
+
+def soft_float_symbols(firmware: Path) -> list[str]:
+    """The soft-float routines (compiler-rt's double and single precision) linked into the
+    firmware next to ``firmware`` (its firmware.elf), by the toolchain's nm."""
+    nm = subprocess.run(["riscv64-unknown-elf-nm", str(firmware.with_suffix(".elf"))],
+                        capture_output=True, text=True)
+    if nm.returncode != 0:
+        raise SystemExit(f"soc-sim: nm failed on {firmware.with_suffix('.elf')}: {nm.stderr}")
+    names = {line.split()[-1] for line in nm.stdout.splitlines() if line.strip()}
+    return sorted(names.intersection(SOFT_FLOAT))
 
 
 def rom_words(firmware: Path) -> list[int]:

@@ -46,9 +46,9 @@ def engine_write_lag(channels: int) -> int:
 
 def engine_lag(channels: int) -> int:
     """The most clocks the shared engine (ENGINE = 1) takes to show a step in COUNT, an event in
-    EVENTS or a snapshot in SNAP_*: one visit round (12 clocks a channel, at least two channels)
-    plus the visit that writes it (rtl/enc_qei_engine.v)."""
-    return 12 * max(channels, 2) + 24
+    EVENTS or a snapshot in SNAP_*: one visit round (24 clocks a channel, at least two channels)
+    plus the visit that computes it and the one that writes it (rtl/enc_qei_engine.v)."""
+    return 24 * max(channels, 2) + 52
 
 # ---- configurations and the pytest side -----------------------------------------------------------
 # (top, COUNT_W, TS_W, PROFILE, ENGINE): one channel each; the shared engine builds the lean profile
