@@ -251,6 +251,7 @@ async def compare_enable(dut):
     cmp = 0x10
     await env.setup(model, count=cmp - 3, filter_len=1)  # compare=None: CMP_EN = 0
     await bus.set64("COMPARE", cmp)
+    await env.applied()
     steps = [1] * 6 + [-1] * 6 + [1] * 3  # through COMPARE both ways, ending on it
     await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
     await bus.set_count(cmp)
@@ -260,7 +261,7 @@ async def compare_enable(dut):
     assert pulses == 0, f"cmp_out pulsed {pulses} times with CMP_EN = 0"
     ctrl = pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, CMP_EN=1)
     await bus.wr("CTRL", ctrl)
-    await env.settle()
+    await env.settle()  # (the shared engine: the write acts within its latency too)
     await env.check(model, "CMP_EN set while the count equals COMPARE")  # (model: compare None)
     assert pulses == 0, "setting CMP_EN on COMPARE pulsed cmp_out"
     model.compare, model.cmp_hits = cmp, 0
@@ -272,6 +273,7 @@ async def compare_enable(dut):
     await env.check(model, "CMP_EN = 1: steps onto COMPARE and a load of it")
     assert pulses == model.cmp_hits == 3, f"cmp_out pulsed {pulses} times, model {model.cmp_hits}"
     await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, CMP_EN=0))
+    await env.applied()
     model.compare = None
     await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
     await env.settle()

@@ -1,14 +1,16 @@
 # SPDX-License-Identifier: Apache-2.0
-"""enc_qei's shared engine (ENGINE = 1) against its promises, on 1, 3 and 16 channels, and the
-same tests on a build with a datapath per channel (the reference: every value the same, shown at
-once):
+"""enc_qei's shared engine (ENGINE = 1) against its promises, the RDL text of CAPS.ENGINE's value
+shared (P = 24 x max(CHANNELS, 2), the constants ENGINE_* of enctools.qei.env), on 1, 3 and 16
+channels, and the same tests on a build with a datapath per channel (the reference: every value
+the same, shown at once):
 
-- latency: a step shows in COUNT, an event in EVENTS, on irq and IRQ_SUMMARY, a level in STATUS,
-  an index latch in INDEX_LATCH, a quadrature error in QERR_COUNT and a global snapshot in
-  SNAP_TIME at most L = engine_lag(CHANNELS) clocks later than on the per-channel build (measured
-  to the clock at every phase of the engine's visits, P = engine_period(CHANNELS) apart);
-- a bus write is answered at once and takes effect within engine_write_lag(CHANNELS) clocks, once,
-  in order with the reads and writes after it;
+- latency: a step shows in COUNT at most P + 24 clocks later than on the per-channel build, an
+  event in EVENTS, a level in STATUS, an index latch in INDEX_LATCH, a quadrature error in
+  QERR_COUNT and a global snapshot in SNAP_TIME at most P + 44 later, irq and IRQ_SUMMARY rise at
+  most P + 44 later (measured to the clock at every phase of the engine's reads of a channel);
+- a bus write is answered in 4 clocks (2 per channel) and acts once, at most P + 18 clocks after
+  its request (a COUNT_LO write), or P + 26 (EVENTS, QERR_COUNT: on what a read could show at
+  the request, an event after it stays), in order with the reads and writes after it;
 - every value exact: independent clock-exact random walks on every channel at the count-rate bound
   with index presets and latches, global snapshots every few hundred clocks, each channel against
   its own model; channels isolated from each other's bus traffic; reset in mid-motion;
@@ -30,8 +32,9 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from enctools.qei.bus import WbRaw, signed
-from enctools.qei.env import (PROFILES, begin, build_name, channel_envs, engine_period,
-                              engine_write_lag, read_snapshot)
+from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_SHOW, ENGINE_SHOW_COUNT,
+                              ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin, build_name,
+                              channel_envs, engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
 from enctools.qei.stimulus import ClockWalk, pulse_rst
 from enctools.regmap import addr, built_mask, event_bits, field, pack, regmap, units
@@ -41,6 +44,9 @@ from enctools.tb import cocotb_test
 ENGINE_CONFIGS = (("enc_qei_wb", 1, 0), ("enc_qei_wb", 1, 1), ("enc_qei_wb", 3, 1),
                   ("enc_qei_wb", 16, 1))
 
+CHAN_REGS = tuple(r for r, x in regmap().items() if x.group == "chan")
+TRAFFIC = ("CTRL", "COUNT_LO", "COUNT_HI", "PRESET_LO", "PRESET_HI", "INDEX_CTRL", "EVENTS",
+           "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "SNAP_CTRL")
 QERR = event_bits("QERR")
 STATUS_Z = field("STATUS", "Z").mask
 
@@ -89,17 +95,19 @@ async def poll(raw: WbRaw, adr: int, shown, s: int, limit: int) -> tuple[int, in
 
 # The latencies of the per-channel build (clocks from the stimulus's stamp to the first read that
 # shows it, WbRaw's stamps; irq: to the clock it is high): fixed, checked on that build; the
-# engine may add at most engine_lag(CHANNELS).
+# engine may add at most P + SHOWN[kind].
 REF = {"COUNT": 5, "EVENTS": 4, "irq": 5, "IRQ_SUMMARY": 5, "STATUS": 2, "INDEX_LATCH": 5,
        "QERR_COUNT": 4, "SNAP_TIME": 3}
+SHOWN = dict({k: ENGINE_SHOW for k in REF}, COUNT=ENGINE_SHOW_COUNT, irq=ENGINE_IRQ,
+             IRQ_SUMMARY=ENGINE_IRQ)
 
 
 @cocotb_test()
 async def latency(dut):
     """Per kind, trials at phases spread over the engine's visits (relative to the visit of the
     channel tried, a random one), then around the worst phase found: the clocks until a read
-    shows the change. Per-channel build: exactly REF. Engine: never more than REF + L, and the
-    worst trial more than P (it reached the channel's far phase)."""
+    shows the change. Per-channel build: exactly REF. Engine: never more than REF + P + SHOWN,
+    and the worst trial more than P (it reached the channel's far phase)."""
     env, rng = await begin(dut)
     n = int(dut.CHANNELS.value)
     envs = channel_envs(dut, rng, n)
@@ -182,9 +190,10 @@ async def latency(dut):
             rel = phases.pop(0)
             k = rng.randrange(n)
             lo, hi = await trial(kind, k, rel)
-            assert lo <= REF[kind] + lag, \
+            bound = p + SHOWN[kind] if env.engine else 0
+            assert lo <= REF[kind] + bound, \
                 f"{kind}, channel {k}: a read {lo - 1} clocks after the stimulus did not show it " \
-                f"(per-channel build: {REF[kind]} clocks; the engine may add {lag})"
+                f"(per-channel build: {REF[kind]} clocks; the engine may add P + {SHOWN[kind]})"
             results.append((lo, hi, rel))
             if len(results) == coarse and env.engine:  # then around the worst phase found
                 worst = max(results)[2]
@@ -196,8 +205,8 @@ async def latency(dut):
             assert lo_max <= REF[kind] <= hi_min, \
                 f"{kind}: the per-channel build shows it after {lo_max} .. {hi_min} clocks, not {REF[kind]}"
         else:
-            dut._log.info("%s: at worst %d .. %d clocks later than the per-channel build (L %d, P %d)",
-                          kind, *found[kind], lag, p)
+            dut._log.info("%s: at worst %d .. %d clocks later than the per-channel build (bound "
+                          "P + %d, P %d)", kind, *found[kind], SHOWN[kind], p)
             assert lo_max - REF[kind] > p, \
                 f"{kind}: the worst trial was only {lo_max - REF[kind]} clocks late (P {p}): the " \
                 "trials missed the channel's far phase"
@@ -205,7 +214,7 @@ async def latency(dut):
     out = os.environ.get("ENC_RESULTS")
     if out and env.engine:
         with open(out, "w") as fh:
-            json.dump({"channels": n, "P": p, "L": lag, "worst": found}, fh)
+            json.dump({"channels": n, "P": p, "bounds": SHOWN, "worst": found}, fh)
 
 
 # ---- every channel moving at once ---------------------------------------------------------------------
@@ -316,28 +325,78 @@ async def random_motion(dut):
 # ---- bus writes -----------------------------------------------------------------------------------------
 # A COUNT_LO write's load clock on the per-channel build: the write request's stamp + REF_LOAD (the
 # clock E such that the steps whose pins were set after E - Timeline.SNAP_PIPE count from the
-# written value); the engine loads within engine_write_lag(CHANNELS) after that.
+# written value); the engine loads at most P + ENGINE_ACT after that.
 REF_LOAD = 4
-REF_ANSWER = 3  # clocks from a write request's stamp to the falling edge after its acknowledge
-ANSWER = 8  # ... the engine's most (6 or 7 measured: a COUNT_LO write reads COUNT first), its slot free
+GLOBAL_REGS = ("ID", "CAPS", "TIMEBASE", "TB_PRESCALE", "GSNAP_CTRL", "GSNAP_PERIOD", "GSNAP_TIME",
+               "IRQ_SUMMARY")
+
+
+async def answered(raw: WbRaw, adr: int, data: int | None = None) -> int:
+    """Clocks from an access's request to its answer (WbRaw's stamp: the clock before the request
+    is sampled; its return: the falling edge after the acknowledge)."""
+    stamp, _, err = await raw.access(adr, data)
+    assert not err, f"access of {adr:#x} answered an error"
+    return int(raw.tb.value) - stamp
+
+
+@cocotb_test()
+async def answer_times(dut):
+    """Every channel register of a random channel, read, then written with what it read (a COUNT_LO
+    write: count_lo_write_answer), at random phases of the engine's reads, each when no write of
+    the channel waits: answered ENGINE_ANSWER clocks after its request on the engine,
+    PER_CHANNEL_ANSWER on the per-channel build (the RDL); the global registers in
+    PER_CHANNEL_ANSWER on both."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    wait = engine_period(n) + ENGINE_WAIT if env.engine else 2
+    want = ENGINE_ANSWER if env.engine else PER_CHANNEL_ANSWER
+    late = []
+    for reg in CHAN_REGS + GLOBAL_REGS:
+        k = rng.randrange(n) if reg in CHAN_REGS else 0
+        adr = addr(reg, k)
+        await ClockCycles(dut.clk, wait + rng.randrange(engine_period(n)))
+        got = await answered(raw, adr)
+        value = (await raw.access(adr))[1]
+        await ClockCycles(dut.clk, wait + rng.randrange(engine_period(n)))
+        put = None if reg == "COUNT_LO" else await answered(raw, adr, value)
+        exp = want if reg in CHAN_REGS else PER_CHANNEL_ANSWER
+        if got != exp or put not in (None, exp):
+            late.append((reg, got, put))
+    assert not late, f"answered not {want} (channel registers) / {PER_CHANNEL_ANSWER} (global ones) " \
+                     f"clocks after the request (register, read, write): {late}"
+
+
+@cocotb_test()
+async def count_lo_write_answer(dut):
+    """A COUNT_LO write, when no write of its channel waits, is answered ENGINE_ANSWER clocks after
+    its request on the engine (the RDL: "a read or a write of a channel register is answered 4
+    clocks after its request"), PER_CHANNEL_ANSWER on the per-channel build."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    want = ENGINE_ANSWER if env.engine else PER_CHANNEL_ANSWER
+    seen = set()
+    for _ in range(8):
+        await ClockCycles(dut.clk, engine_period(n) + ENGINE_WAIT + rng.randrange(engine_period(n)))
+        seen.add(await answered(raw, addr("COUNT_LO", rng.randrange(n)), rng.getrandbits(32)))
+    assert seen == {want}, f"COUNT_LO writes answered {sorted(seen)} clocks after the request, not {want}"
 
 
 @cocotb_test()
 async def write_effect(dut):
-    """Every channel moving forward a step a clock; at phases spread over the engine's visits, a
-    COUNT_LO write to a random channel: answered at once (ANSWER clocks, not waiting for the
-    engine's visit); a read right
-    after it already gives the written count (plus the steps since); it loads the count once, in
-    one clock E (from a global snapshot later: SNAP_COUNT = value + the steps after E) no earlier
-    than on the per-channel build and at most engine_write_lag(CHANNELS) later. Then, a channel
-    standing still, COUNT_LO writes with some byte lanes: the other lanes from COUNT."""
+    """Every channel moving forward a step a clock; at phases spread over the engine's reads, a
+    COUNT_LO write to a random channel: a read right after it gives the written count (plus the
+    steps since); it loads the count once, in one clock E (from a global snapshot later: SNAP_COUNT =
+    value + the steps after E), no earlier than on the per-channel build and at most
+    P + ENGINE_ACT later. Then, a channel standing still, COUNT_LO writes with some byte lanes: the
+    other lanes from COUNT."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     raw = WbRaw(dut)
-    tb = dut.u_qei.timebase
     p = engine_period(n) if env.engine else 2
     visit = p // max(n, 2)
-    wlag = engine_write_lag(n) if env.engine else 0
+    wlag = p + ENGINE_ACT if env.engine else 0
     walker = ClockWalk(dut, models, rng, positions=[e.pos for e in envs], shortest=1, longest=1,
                        p_reverse=0)
     task = cocotb.start_soon(walker.run(10 ** 9))
@@ -347,10 +406,7 @@ async def write_effect(dut):
         k = rng.randrange(n)
         value = rng.getrandbits(32) & ~0xFFFF | 0x8000
         await at_phase(dut, p, (i * p // trials + rng.randrange(max(1, p // trials)) + visit * k) % p)
-        w, _, err = await raw.access(addr("COUNT_LO", k), value)
-        answered = int(tb.value) - w
-        assert not err and answered <= (ANSWER if env.engine else REF_ANSWER), \
-            f"channel {k}: COUNT_LO write answered after {answered} clocks"
+        w, _, _ = await raw.access(addr("COUNT_LO", k), value)
         _, got, _ = await raw.access(addr("COUNT_LO", k))
         since = (got - value) & 0xFFFFFFFF
         assert since <= wlag + env.lag + 20, \
@@ -449,9 +505,6 @@ async def clears_keep_later_events(dut):
 
 
 # ---- isolation and reset ------------------------------------------------------------------------------
-CHAN_REGS = tuple(r for r, x in regmap().items() if x.group == "chan")
-TRAFFIC = ("CTRL", "COUNT_LO", "COUNT_HI", "PRESET_LO", "PRESET_HI", "INDEX_CTRL", "EVENTS",
-           "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "SNAP_CTRL")
 
 
 @cocotb_test()
@@ -738,7 +791,7 @@ async def snap_ready_means_values(dut):
         got = {r: (await raw.access(addr(r, k)))[1] for r in regs}
         t = walker.unwrap(got["SNAP_TIME"])
         what = f"trial {i}, channel {k}, {'GSNAP_CTRL' if i % 2 else 'SNAP_CTRL'}.CMD"
-        assert t0 <= t <= t0 + sn.p + 12, \
+        assert t0 <= t <= t0 + sn.p + ENGINE_ACT, \
             f"{what}: SNAP_READY with SNAP_TIME {got['SNAP_TIME']:#x}, asked at {t0 & ts_mask:#x}"
         line = walker.lines[k]
         mark = line.at(t)

@@ -82,6 +82,7 @@ async def index_gate_same_position(dut):
     gate = QUAD[6 % 4]
     await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", GATE_EN=1, GATE_A=gate[0],
                                     GATE_B=gate[1], ARM=1))
+    await env.applied()
     zf = lambda p: int(5 <= p <= 7)  # noqa: E731
     for direction in (1, -1, 1, -1):
         target = 12 if direction > 0 else 0
@@ -257,6 +258,7 @@ async def probe_time_exact(dut):
         value = (0x0F0F_0F0F_5A5A_A5A5 >> k | 1 << 2 * k) & model.max
         await env.setup(model, count=value)
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
+        await env.applied()
         await Timer((73 * k + 5) * PERIOD_PS, unit="ps")
         await FallingEdge(dut.clk)
         before = await bus.rd("TIMEBASE")
@@ -443,6 +445,7 @@ async def index_preset_slice_compares(dut):
         model.ceiling = ceiling
         for preset in presets:
             await bus.set64("PRESET", preset)
+            await env.applied()
             model.preset = preset
             await play_clocks(env, model, step_clocks(env.pos, (+1, +1, -1, 0), (1, 0, 0, 0)))
             await env.settle(4)
