@@ -17,7 +17,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, lacks, run_feature
+from enctools.qei.env import (ENGINE_SHOW, CONFIG_IDS, CONFIGS, FILTER, begin, engine_period, lacks,
+                              run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, play_clocks
 from enctools.regmap import event_bits, get_field, pack
@@ -100,12 +101,15 @@ async def events_and_irq(dut):
             await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
         elif name == "PERIOD_READY":
             await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, N=1))
+            await env.applied()
             await env.play(walk([1, 1], [45.0, 45.0], start_pos=env.pos), None)
             await bus.wr("PERIOD_CTRL", 0)
         elif name == "STALL":
             await bus.wr("STALL_TIMEOUT", 20)
+            await env.applied()
             await env.settle(30)
             await bus.wr("STALL_TIMEOUT", 0)
+        await env.applied()  # (the shared engine: what a write did shows up to its latency later)
         await env.settle()
 
     names = ["OVERFLOW", "UNDERFLOW", "DIR_CHANGE", "CMP", "QERR", "GLITCH", "INDEX", "PROBE",
@@ -209,6 +213,7 @@ async def cmp_on_load(dut):
                                     ("preset", cmp, None)):
             await bus.set_count(before)
             model.write_count(before)
+            await env.applied()
             await env.settle(4)
             await env.check(model, f"EN {en}: COUNT write of {before:#x}")
             del high[:]
@@ -216,6 +221,7 @@ async def cmp_on_load(dut):
             if value is not None:
                 await bus.set_count(value)
                 model.write_count(value)
+                await env.applied()
             else:  # an index pulse (FILTER_LEN 1: Z high for 3 clocks)
                 await play_clocks(env, model, [(env.pos, 1)] * 3 + [(env.pos, 0)])
             await env.settle()
@@ -228,6 +234,53 @@ async def cmp_on_load(dut):
         await bus.wr("INDEX_CTRL", 0)
         model.idx_action = "none"
     mon.cancel()
+
+
+@cocotb_test(skip=lacks("RANGE"))
+async def cmp_on_load_shows(dut):
+    """A COUNT write that loads COMPARE (CMP_EN = 1): cmp_out pulses in the clock of the load, and
+    every read of EVENTS requested ENGINE_SHOW + P clocks or more after that clock shows CMP (the
+    shared engine's bound for a value, CAPS.ENGINE; a per-channel build: 3 clocks)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    cmp = 0x0000_0002_4000_0011 & model.max
+    tb = dut.u_qei.timebase
+    bound = engine_period(int(dut.CHANNELS.value)) + ENGINE_SHOW if env.engine else 3
+    pulse = [None]
+
+    async def watch():
+        while True:
+            await RisingEdge(dut.clk)
+            if dut.cmp_out.value == 1 and pulse[0] is None:
+                pulse[0] = int(tb.value)
+
+    mon = cocotb.start_soon(watch())
+    await env.setup(model, count=cmp - 1, compare=cmp, filter_len=1)
+    worst = 0
+    for trial in range(8):
+        await bus.set_count(cmp - 1 - trial)
+        await env.settle()
+        await bus.events()
+        await env.applied()
+        pulse[0] = None
+        await bus.set_count(cmp)
+        for _ in range(4 * env.lag + 20):
+            if pulse[0] is not None:
+                break
+            await RisingEdge(dut.clk)
+        assert pulse[0] is not None, f"trial {trial}: no cmp_out pulse after a COUNT write of COMPARE"
+        while True:
+            start = int(tb.value)
+            if await bus.rd("EVENTS") & event_bits("CMP"):
+                break
+            assert start - pulse[0] < bound, \
+                f"trial {trial}: EVENTS read {start - pulse[0]} clocks after the load (cmp_out) " \
+                f"without CMP (bound {bound})"
+        worst = max(worst, int(tb.value) - pulse[0])
+        await ClockCycles(dut.clk, rng.randrange(50))
+    mon.cancel()
+    dut._log.info("CMP of a load shown at most %d clocks after cmp_out (bound %d)", worst, bound)
 
 
 @cocotb_test(skip=lacks("RANGE"))

@@ -808,6 +808,35 @@ async def snap_ready_means_values(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
+def test_rdl_says_the_bounds():
+    """The RDL text of CAPS.ENGINE's value shared gives the bounds these tests hold the RTL to
+    (enctools.qei.env.ENGINE_*), in these words."""
+    import re
+
+    from enctools.qei import env
+    from enctools.regmap import nodes
+
+    caps = {r.inst_name: r for _, _, r in nodes()}["CAPS"]
+    enc = next(f for f in caps.fields() if f.inst_name == "ENGINE").get_property("encode")
+    text = " ".join(next(m for m in enc if m.name == "shared").rdl_desc.split())
+    said = {
+        "ENGINE_VISIT": r"P = (\d+) \* max\(CHANNELS, 2\)",
+        "ENGINE_SHOW": r"request comes P \+ (\d+) clocks or more after",
+        "ENGINE_SHOW_COUNT": r"\(COUNT_LO and COUNT_HI: P \+ (\d+) clocks\)",
+        "ENGINE_IRQ": r"irq and IRQ_SUMMARY rise and fall at most P \+ (\d+) clocks",
+        "ENGINE_ACT": r"acts at the channel's first read after it, at most P \+ (\d+) clocks",
+        "ENGINE_STATE_ACT": r"COUNT_HI acts \(irq included\) at most P \+ (\d+) clocks",
+        "ENGINE_WAIT": r"has not acted \(at most P \+ (\d+) clocks\)",
+        "ENGINE_ANSWER": r"answered (\d+) clocks after its request",
+        "PER_CHANNEL_ANSWER": r"answered \d+ clocks after its request \((\d+) in a per_channel build\)",
+    }
+    for name, pattern in said.items():
+        m = re.search(pattern, text)
+        assert m, f"CAPS.ENGINE shared: no {pattern!r} in its text"
+        assert int(m.group(1)) == getattr(env, name), \
+            f"CAPS.ENGINE shared says {m.group(0)!r}, enctools.qei.env.{name} = {getattr(env, name)}"
+
+
 @pytest.mark.parametrize("top,channels,engine", ENGINE_CONFIGS,
                          ids=[f"{t}-ch{c}" + ("-engine" if e else "") for t, c, e in ENGINE_CONFIGS])
 def test_engine(top, channels, engine):
