@@ -256,7 +256,7 @@ module enc_qei_lane_formal #(
       assert (e_mb == e_m[MOT_W-1:0] && e_qb == e_q[ERR_W-1:0] && e_gb == e_g[ERR_W-1:0]);
       assert (wdist(f_m, e_m) <= el_w && f_q - e_q <= el_w && f_g - e_g <= el_w);
       // a capture waiting: taken in this window (or in the clock of the last read)
-      if (p_spend) assert (wdist(f_m, f_sm) <= el_w && age_st <= el_w &&
+      if (p_spend) assert (wdist(f_m, f_sm) <= el_w && wdist(f_sm, e_m) <= el_w && age_st <= el_w &&
                            p_smpos == f_sm[MOT_W-1:0] && p_stime == f_st[TIM_W-1:0]);
       if (p_ppend) assert (age_pt <= el_w && p_ptime == f_pt[TIM_W-1:0]);
       if (rd) begin
