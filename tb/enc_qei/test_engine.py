@@ -837,6 +837,48 @@ def test_rdl_says_the_bounds():
             f"CAPS.ENGINE shared says {m.group(0)!r}, enctools.qei.env.{name} = {getattr(env, name)}"
 
 
+# what each register's own RDL text must state for the shared engine (the contract: "the RDL text
+# of that register gives the bound in clocks as a formula in CHANNELS"): P + the env constant
+SHOWN = ("STATUS", "INDEX_LATCH_LO", "INDEX_LATCH_HI", "PROBE_LATCH_LO", "PROBE_LATCH_HI",
+         "PROBE_TIME", "EVENTS", "QERR_COUNT", "GLITCH_COUNT", "SNAP_COUNT_LO", "SNAP_COUNT_HI",
+         "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA", "PERIOD", "IRQ_SUMMARY")
+ACTING = ("CTRL", "COUNT_LO", "PRESET_LO", "PRESET_HI", "CEILING_LO", "CEILING_HI", "COMPARE_LO",
+          "COMPARE_HI", "INDEX_CTRL", "PROBE_CTRL", "SNAP_CTRL", "SNAP_PERIOD", "PERIOD_CTRL",
+          "STALL_TIMEOUT")
+STATE_ACTING = ("EVENTS", "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "COUNT_HI")
+
+
+def test_registers_state_their_bounds():
+    """Every register whose value the engine shows later, or whose write acts later, states that
+    bound in its own RDL text as 24 * max(CHANNELS, 2) + N with the N of CAPS.ENGINE's text (shown
+    P + 44, COUNT P + 24, acting P + 18, state writes P + 26); no text gives another number."""
+    import re
+
+    from enctools.qei import env
+    from enctools.regmap import nodes
+
+    said: dict[str, set[int]] = {}
+    for _, _, r in nodes():
+        text = " ".join([r.get_property("desc") or ""] +
+                        [f.get_property("desc") or "" for f in r.fields()])
+        for m in re.finditer(rf"{env.ENGINE_VISIT} \* max\(CHANNELS, 2\) \+ (\d+)", " ".join(text.split())):
+            said.setdefault(r.inst_name, set()).add(int(m.group(1)))
+    want = {r: {env.ENGINE_SHOW} for r in SHOWN}
+    want["COUNT_LO"] = {env.ENGINE_SHOW_COUNT}
+    for r in ACTING:
+        want.setdefault(r, set()).add(env.ENGINE_ACT)
+    for r in STATE_ACTING:
+        want.setdefault(r, set()).add(env.ENGINE_STATE_ACT)
+    for r, bounds in want.items():
+        missing = bounds - said.get(r, set())
+        assert not missing, f"{r}: its RDL text does not state P + {sorted(missing)}"
+    known = {env.ENGINE_SHOW, env.ENGINE_SHOW_COUNT, env.ENGINE_ACT, env.ENGINE_STATE_ACT,
+             env.ENGINE_WAIT, env.ENGINE_IRQ}
+    for r, bounds in said.items():
+        assert bounds <= known, f"{r}: its RDL text states P + {sorted(bounds - known)}, a bound " \
+                                f"CAPS.ENGINE's text does not give"
+
+
 @pytest.mark.parametrize("top,channels,engine", ENGINE_CONFIGS,
                          ids=[f"{t}-ch{c}" + ("-engine" if e else "") for t, c, e in ENGINE_CONFIGS])
 def test_engine(top, channels, engine):
