@@ -18,10 +18,10 @@
 //     and at no other time but the clock before that, which only a COUNT write's value uses, and
 //     then ld comes with the push after it (the value a clock ahead of its load);
 //   - the state memory's port a never reads, in a slot whose data the engine uses (1 .. 22), the
-//     word written in that clock (enc_qei_ram has no read-during-write bypass); the bus's port-b
-//     read whose data is used (B_READ, B_CNT the clock after) was not of the word written in its
-//     clock (b_clash retries it); the write slots' memory (u_pend) is never read for a taken write
-//     in the clock it is written, on either port;
+//     word written in that clock (enc_qei_ram has no read-during-write bypass); the port-b data
+//     the bus takes (the first of its two reads, or the second when the first met a write of
+//     its word: b_clash) was not read in a clock that wrote that word; the write slots' memory
+//     (u_pend) is never read for a taken write in the clock it is written, on either port;
 //   - a bus write is taken once and applied once: per channel, a write waits (pend) or is being
 //     applied (busy), never both; the bus posts a write only into a free slot of a channel with no
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
@@ -107,6 +107,7 @@ module enc_qei_engine_formal #(
   (* keep *) wire [AW-1:0]       p_raddr_b;   // eng.raddr_b
   (* keep *) wire [2:0]          p_b_st;      // eng.b_st_q
   (* keep *) wire [3:0]          p_b_ch;      // eng.b_ch_q: the request's channel
+  (* keep *) wire                p_b_take;    // eng.b_take: the bus takes port b's data now
   (* keep *) wire [CHANNELS-1:0] p_pend;      // eng.pend_q
   (* keep *) wire [CHANNELS-1:0] p_busy;      // eng.busy_q
   (* keep *) wire [CHANNELS-1:0] p_pend_st;   // eng.pend_st_q
@@ -121,7 +122,7 @@ module enc_qei_engine_formal #(
   (* keep *) wire                p_pend_we;   // eng.pend_we: the write slots' write
   (* keep *) wire [3:0]          p_pend_wch;  // eng.pend_wch
 
-  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_READ = 3'd2, B_CNT = 3'd3, B_POST = 3'd4,
+  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_RD1 = 3'd2, B_RD2 = 3'd3, B_POST = 3'd4,
                    B_DONE = 3'd5;
 
   // ---- the port's rules ---------------------------------------------------------------------------
@@ -160,15 +161,16 @@ module enc_qei_engine_formal #(
   reg [7:0]          f_cnt [0:CHANNELS-1];
   reg [CHANNELS-1:0] f_seen;
   reg [CHANNELS-1:0] f_cfg_we1;  // cfg_we the clock before
-  reg                f_wclash_a, f_wclash_b;  // a write to the word port a / b read in that clock
+  reg                f_wclash_b; // a write to the word port b read in that clock
+  reg                f_took1;    // the bus took port b's first read
   // per channel: writes posted and not completed (the wrapper's count)
   reg [1:0]          f_owed [0:CHANNELS-1];
   integer            k;
 
   always @(posedge clk) begin
     f_cfg_we1  <= rst ? {CHANNELS{1'b0}} : p_cfg_we;
-    f_wclash_a <= p_we & (p_waddr == p_raddr_a);
     f_wclash_b <= p_we & (p_waddr == p_raddr_b);
+    f_took1    <= (p_b_st == B_RD1) & p_b_take;
     for (k = 0; k < CHANNELS; k = k + 1) begin
       if (rst) begin
         f_cnt[k]  <= 8'd0;
@@ -215,13 +217,16 @@ module enc_qei_engine_formal #(
       if (p_slot >= 5'd22) assert (!(p_p_taken && p_e_taken));
       // (the bus: a write on its way to its slot found the channel with no write unapplied)
       assert (p_b_st <= B_DONE && (p_b_st == B_IDLE || p_b_ch < CHANNELS));
-      if (p_b_st == B_CNT || p_b_st == B_POST) assert (!(|((p_pend | p_busy) & (1 << p_b_ch))));
+      if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST)
+        assert (!(|((p_pend | p_busy) & (1 << p_b_ch))));
       assert (p_pend_set == ((p_b_st == B_DONE && p_pend_we) ? (1 << p_b_ch) : 0));
       if (p_pend_we) assert (p_b_st == B_DONE && p_pend_wch == p_b_ch);
       // port a: a read whose data is used (slots 1 .. 22) is not of the word written in its clock
       if (p_slot >= 1 && p_slot <= V - 2) assert (!(p_we && p_waddr == p_raddr_a));
-      // port b: the data used (B_READ, B_CNT) was not read in a write's clock to that word
-      if (p_b_st == B_READ || p_b_st == B_CNT) assert (!f_wclash_b);
+      // port b: the data the bus takes (B_RD1's, or B_RD2's after a clash) was not read in a
+      // write's clock to that word; it takes one of its two reads, exactly one
+      if (p_b_take) assert (!f_wclash_b && (p_b_st == B_RD1 || p_b_st == B_RD2));
+      if (p_b_st == B_RD2) assert (p_b_take != f_took1);
       // the write slots: a taken write's word is not written in the clock it is read
       if (p_slot == 5'd9 && (|(p_pend & ~p_pend_st & (1 << p_cn))))
         assert (!(p_pend_we && p_pend_wch == p_cn));
