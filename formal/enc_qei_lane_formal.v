@@ -14,14 +14,15 @@
 // From each record the wrapper rebuilds what the engine rebuilds, with the engine's formulas:
 // the motion M += the signed difference of mpos and its value at the read before; the error and
 // glitch counts += the difference of qcnt / gcnt (mod 2^ERR_W); a timestamp = the timebase at the
-// read - (its low bits at the read - the TIM_W bits kept), mod 2^TS_W; a snapshot's motion = M at
+// read - (its low bits at the read - the TIM_W bits kept), mod 2^16; a snapshot's motion = M at
 // the read before + the signed difference of smpos and mpos then.
 // Proven (k-induction) at every read, against the wrapper's wide counts of the lane's own decode
 // (step_up / step_dn, qerr) and filters (glitch_q), and its own timebase: M equals the steps
 // counted (each +1 / -1), the error and glitch counts equal the errors and rejected levels
 // counted; a snapshot waiting at the read has the timebase and the motion of its clock, a probe
-// latch the timebase of its clock. With one bit less of MOT_W or two of ERR_W (the wrapper's
-// MOT_CUT / ERR_CUT, the deliberate breaks) it fails.
+// latch the timebase of its clock. With three bits less of MOT_W or two of ERR_W (the wrapper's
+// MOT_CUT / ERR_CUT, deliberate breaks) it fails; with two and one it passes (MOT_W is sized for
+// the reach of lo, not for the motion).
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
 // formal/README.md: that comparison did not finish within the time a task may take).
 `default_nettype none
