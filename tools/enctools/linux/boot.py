@@ -47,6 +47,21 @@ class Outcome:
     console: str
     seconds: float
     finished: bool
+    answers: str = ""           # the model server's bus answers against the RDL's bound
+
+
+ANSWERS_RE = re.compile(r"answers: the longest (\d+) clocks after its request, (\d+) later than "
+                        r"the bound of (\d+)")
+
+
+def answers_result(text: str) -> tuple[bool, str]:
+    """The model server's count of bus answers later than the RDL's bound (its last line)."""
+    m = ANSWERS_RE.search(text)
+    if not m:
+        return False, "the model server did not report its bus answers"
+    longest, late, bound = map(int, m.groups())
+    return late == 0, (f"bus answers within {bound} clocks of the request (rtl/enc_qei.rdl): "
+                       f"{late} later, the longest {longest}")
 
 
 def dts(b: Boot) -> str:
@@ -188,7 +203,9 @@ def run(b: Boot, linux: Path, server: Path, dtc: Path, module: Path, init: Path,
     text = "".join(console).replace("\r\n", "\n") + server_out
     (work / "console.log").write_text(text)
     results, finished = parse(text)
+    answers = answers_result(text)
+    results.append(answers)
     for pattern in b.expect:
         results.append((re.search(pattern, text, re.M) is not None,
                         f"console shows /{pattern}/"))
-    return Outcome(b, results, text, time.monotonic() - t0, finished)
+    return Outcome(b, results, text, time.monotonic() - t0, finished, answers[1])
