@@ -25,9 +25,10 @@
 //
 // The RDL bounds the answer to an access: 2 clocks after its request on a per_channel build, and
 // on the shared engine P + 44 (a read or a write of a channel waits at most P + 40 for a write of
-// that channel to act, then is answered 4 clocks later). The server counts the answers that come
-// later than that and prints them, with the longest, at exit; it waits up to four times the
-// bound, plus 16 clocks, before it gives up on an access (a bus error).
+// that channel to act, then is answered 4 clocks later). The server measures it: it names the
+// first 8 answers later than that (with the access before), and prints their count and the
+// longest answer at exit; it waits up to four times the bound, plus 16 clocks, before it gives
+// up on an access (a bus error, and a line "no answer").
 //
 // --id makes reads of ID answer WORD instead of the RTL's ID (the driver's refusal of a wrong ID
 // or version is tested with it). The parameters of the build (CHANNELS, PROFILE, COUNT_W, TS_W,
@@ -63,6 +64,9 @@ uint64_t clocks;
 int answer_bound = 2;       // clocks from a request to its answer, at most, by the RDL (above)
 int longest_answer;         // the longest seen
 uint64_t late_answers;      // answers later than answer_bound
+uint32_t prev_addr;         // the access before (for the report of a late answer)
+bool prev_we;
+uint64_t prev_clock;
 
 void tick() {
     top->clk = 0;
@@ -86,6 +90,7 @@ void drive_inputs() {
 
 // One Wishbone access; returns the status (0 ack, 1 err) and the read data in *data.
 uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
+    const uint64_t request = clocks;
     top->wb_adr_i = addr;
     top->wb_dat_i = *data;
     top->wb_sel_i = sel;
@@ -102,7 +107,12 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
             *data = top->wb_dat_o;
             if (i > longest_answer)
                 longest_answer = i;
-            late_answers += i > answer_bound;
+            if (i > answer_bound && late_answers++ < 8)
+                fprintf(stderr, "enc_qei_server: late answer: a %s of 0x%03x answered %d clocks "
+                        "after its request (clock %llu), %llu after a %s of 0x%03x\n",
+                        we ? "write" : "read", addr, i, static_cast<unsigned long long>(request),
+                        static_cast<unsigned long long>(request - prev_clock),
+                        prev_we ? "write" : "read", prev_addr);
             break;
         }
     }
@@ -112,6 +122,9 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     top->wb_cyc_i = 0;
     top->wb_stb_i = 0;
     tick();
+    prev_addr = addr;
+    prev_we = we;
+    prev_clock = request;
     return status;
 }
 
