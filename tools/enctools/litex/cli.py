@@ -187,8 +187,8 @@ def engine_section(results: dict) -> list[str]:
         "engine may show a count step, an event and a snapshot some clocks later and lets a "
         "write act later (the bounds: CAPS.ENGINE in doc/enc_qei_regs.md); the driver waits for "
         "each channel's SNAP_READY, and a read of a channel waits until that channel's last "
-        "write has acted, so the driver's clear of SNAP_READY followed by a read of EVENTS "
-        "stalls the CPU until the clear has acted.",
+        "write has acted, so the driver's clear of SNAP_READY followed by its read of "
+        "SNAP_COUNT_LO stalls the CPU until the clear has acted.",
         "",
     ]
     for name in ENGINE_RUNS:
