@@ -60,6 +60,41 @@ async def compare(dut):
 
 
 @cocotb_test()
+async def compare_across_the_wrap(dut):
+    """COMPARE a few steps away across the end of the free range (COMPARE near all ones with the
+    count near 0, and the other way round): walking across the wrap both ways raises CMP and one
+    cmp_out pulse each time the count steps onto COMPARE, as the model says. (The shared engine
+    judges whether COMPARE is within reach of the count modulo 2^COUNT_W.)"""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    pulses = 0
+
+    async def count_pulses():
+        nonlocal pulses
+        while True:
+            await RisingEdge(dut.clk)
+            if dut.cmp_out.value == 1:
+                pulses += 1
+
+    mon = cocotb.start_soon(count_pulses())
+    hits = 0
+    for compare, count in ((model.max - 1, 1), (model.max, 2), (0, model.max - 2), (1, model.max)):
+        await env.setup(model, count=count, compare=compare)
+        model.cmp_hits = 0
+        pulses = 0
+        d = 1 if count > compare else -1  # towards COMPARE: across the wrap
+        steps = [d] * 5 + [-d] * 5 + [d] * 5
+        wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
+        await env.play(wf, model)
+        await env.check(model, f"COMPARE {compare:#x} from {count:#x}")
+        assert pulses == model.cmp_hits, \
+            f"COMPARE {compare:#x} from {count:#x}: cmp_out pulsed {pulses} times, model {model.cmp_hits}"
+        hits += model.cmp_hits
+    mon.cancel()
+    assert hits >= 8 or env.lean, f"the walks reached COMPARE {hits} times"
+
+
+@cocotb_test()
 async def events_and_irq(dut):
     """Every count-side event: set, masked, enabled onto irq, cleared alone by W1C (the events
     of the units a build has)."""
