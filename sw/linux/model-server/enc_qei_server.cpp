@@ -16,19 +16,23 @@
 // A build whose channels share one engine (CAPS.ENGINE = shared, rtl/enc_qei.rdl) shows a change
 // later and lets a write act later, by bounds in clocks of P = 24 * max(CHANNELS, 2). The server
 // keeps the motion clear of them, so that what every register shows after N motion steps is what
-// a per_channel build shows: an advance starts with P + 26 idle clocks (a write answered before
-// it acts by then: P + 18 after its request for CTRL and the other registers the counting uses,
-// P + 26 for EVENTS, IRQ_EN, COUNT_HI and the error counts) and ends, after the last step's
+// a per_channel build shows: an advance starts with P + 22 idle clocks (a write answered before
+// it acts by then: P + 14 after its answer for CTRL and the other registers the counting uses,
+// P + 22 for EVENTS, IRQ_EN, COUNT_HI and the error counts) and ends, after the last step's
 // ENC_STIM_STEP_CLOCKS, with P + 44 more (a change the per_channel build shows within the step
 // shows by then, irq included). The steps keep their spacing: the engine's channels count in the
 // clocks a per_channel build does.
 //
-// The RDL bounds the answer to an access: 2 clocks after its request on a per_channel build, and
-// on the shared engine P + 44 (a read or a write of a channel waits at most P + 40 for a write of
-// that channel to act, then is answered 4 clocks later). The server measures it: it names the
-// first 8 answers later than that (with the access before), and prints their count and the
-// longest answer at exit; it waits up to four times the bound, plus 16 clocks, before it gives
-// up on an access (a bus error, and a line "no answer").
+// The RDL bounds the answer to an access: 2 clocks after its request on a per_channel build; on
+// the shared engine 6 (a read 5, a write 4, a COUNT_LO write with some byte lanes 6, a COUNT_LO
+// read of another channel 6), and an access of a channel waits until that channel's writes are
+// stored: one right after a write is answered at most P + 66 clocks after the write's request.
+// The server holds every access to that bound, counted from the last write of the same 0x100-byte
+// page (a channel); for a write that itself waited for an earlier one, from its answer less 6
+// clocks, as if it had been requested then and not waited (the RDL states the bound for a write
+// that did not wait). It names the first 8 answers later than that (with the access before),
+// prints their count and the longest answer at exit, and gives up on an access after four times
+// P + 66 clocks, plus 16 (a bus error, and a line "no answer").
 //
 // --id makes reads of ID answer WORD instead of the RTL's ID (the driver's refusal of a wrong ID
 // or version is tested with it). The parameters of the build (CHANNELS, PROFILE, COUNT_W, TS_W,
@@ -62,11 +66,15 @@ struct enc_stim stim[kMaxChannels];
 int channels;
 uint64_t clocks;
 int answer_bound = 2;       // clocks from a request to its answer, at most, by the RDL (above)
+int after_write_bound = 2;  // clocks from a write's request to the answer of the access after it
 int longest_answer;         // the longest seen
 uint64_t late_answers;      // answers later than answer_bound
 uint32_t prev_addr;         // the access before (for the report of a late answer)
 bool prev_we;
-uint64_t prev_clock;
+uint64_t prev_request;
+constexpr int kPages = 64;  // 0x100-byte pages of the address space (a channel's registers)
+uint64_t last_write[kPages];  // each page's last write: its request, or for a write that waited
+                              // its answer less answer_bound
 
 void tick() {
     top->clk = 0;
@@ -100,31 +108,39 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     top->eval();
     uint32_t status = 1;
     *data = 0;
-    for (int i = 1; i <= 4 * answer_bound + 16; i++) {
+    const int give_up = 4 * after_write_bound + 16;
+    for (int i = 1; i <= give_up; i++) {
         tick();
         if (top->wb_ack_o || top->wb_err_o) {
             status = top->wb_err_o ? 1 : 0;
             *data = top->wb_dat_o;
             if (i > longest_answer)
                 longest_answer = i;
-            if (i > answer_bound && late_answers++ < 8)
+            const uint64_t since_write = request + i - last_write[addr >> 8 & (kPages - 1)];
+            const bool late = i > answer_bound &&
+                since_write > static_cast<uint64_t>(after_write_bound);
+            if (late && late_answers++ < 8)
                 fprintf(stderr, "enc_qei_server: late answer: a %s of 0x%03x answered %d clocks "
                         "after its request (clock %llu), %llu after a %s of 0x%03x\n",
                         we ? "write" : "read", addr, i, static_cast<unsigned long long>(request),
-                        static_cast<unsigned long long>(request - prev_clock),
+                        static_cast<unsigned long long>(request - prev_request),
                         prev_we ? "write" : "read", prev_addr);
             break;
         }
     }
     if (!top->wb_ack_o && !top->wb_err_o)
         fprintf(stderr, "enc_qei_server: no answer to a %s of 0x%03x within %d clocks\n",
-                we ? "write" : "read", addr, 4 * answer_bound + 16);
+                we ? "write" : "read", addr, give_up);
     top->wb_cyc_i = 0;
     top->wb_stb_i = 0;
     tick();
     prev_addr = addr;
     prev_we = we;
-    prev_clock = request;
+    prev_request = request;
+    // a write that waited itself counts from its answer less answer_bound (see the top)
+    if (we)
+        last_write[addr >> 8 & (kPages - 1)] =
+            clocks - 1 - answer_bound > request ? clocks - 1 - answer_bound : request;
     return status;
 }
 
@@ -203,9 +219,9 @@ int main(int argc, char **argv) {
     // the shared engine's bounds (CAPS.ENGINE, bit 31): see the top of this file
     const bool engine = caps >> 31;
     const int p = 24 * (channels > 2 ? channels : 2);
-    const int settle_before = engine ? p + 26 : 0, settle_after = engine ? p + 44 : 0;
+    const int settle_before = engine ? p + 22 : 0, settle_after = engine ? p + 44 : 0;
     if (engine)
-        answer_bound = p + 44;
+        answer_bound = 6, after_write_bound = p + 66;
     for (int k = 0; k < channels; k++)
         enc_stim_init(&stim[k], static_cast<unsigned>(k));
     drive_inputs();
@@ -266,10 +282,11 @@ int main(int argc, char **argv) {
             break;
     }
     printf("enc_qei_server: %llu accesses, %llu motion steps, %llu clocks; answers: the longest "
-           "%d clocks after its request, %llu later than the bound of %d\n",
+           "%d clocks after its request, %llu later than the bound of %d (%d from a write's "
+           "request after it)\n",
            static_cast<unsigned long long>(accesses), static_cast<unsigned long long>(steps),
            static_cast<unsigned long long>(clocks), longest_answer,
-           static_cast<unsigned long long>(late_answers), answer_bound);
+           static_cast<unsigned long long>(late_answers), answer_bound, after_write_bound);
     top->final();
     delete top;
     unlink(path);
