@@ -186,9 +186,9 @@ def engine_section(results: dict) -> list[str]:
         "(`engine=1`: CAPS.ENGINE = 1), on lean and on full channels, the four motions. The "
         "engine may show a count step, an event and a snapshot some clocks later and lets a "
         "write act later (the bounds: CAPS.ENGINE in doc/enc_qei_regs.md); the driver waits for "
-        "each channel's SNAP_READY, and a read of a channel waits until that channel's last "
-        "write has acted, so the driver's clear of SNAP_READY followed by its read of "
-        "SNAP_COUNT_LO stalls the CPU until the clear has acted.",
+        "each channel's SNAP_READY, and a read of a channel waits until that channel's earlier "
+        "writes are stored in the engine's memory, so the driver's clear of SNAP_READY followed "
+        "by its read of SNAP_COUNT_LO stalls the CPU until the clear is stored.",
         "",
     ]
     for name in ENGINE_RUNS:
