@@ -256,6 +256,17 @@ def index_pulses(rng, n):
     return out
 
 
+async def global_snapshot(env, envs, walker, rng, t_prev, what) -> int:
+    """A global snapshot by command while walker walks; up to four channels' SNAP_* checked against
+    their Timelines; returns its (unwrapped) timebase."""
+    await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+    await env.settle()
+    t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
+    for k in rng.sample(range(len(envs)), min(len(envs), 4)):
+        await check_snapshot(envs[k], walker.lines[k], t, t_prev, f"{what}, channel {k}")
+    return t
+
+
 async def check_snapshot(env, line, t, t_prev, what) -> None:
     """Channel env's SNAP_* against its Timeline at (unwrapped) timebase t; t_prev: the timebase of
     the channel's capture before (None: unknown)."""
@@ -312,12 +323,7 @@ async def random_motion(dut):
     t_prev = None  # the last global snapshot's timebase
     for i in range(snaps):
         await ClockCycles(dut.clk, rng.randint(100, 400))
-        await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
-        await env.settle()
-        t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
-        for k in rng.sample(range(n), min(n, 4)):
-            await check_snapshot(envs[k], walker.lines[k], t, t_prev, f"global snapshot {i}, channel {k}")
-        t_prev = t
+        t_prev = await global_snapshot(env, envs, walker, rng, t_prev, f"global snapshot {i}")
     task.cancel()
     await env.settle()
     for k, (e, m) in enumerate(zip(envs, models)):
@@ -640,11 +646,7 @@ async def reset_mid_motion(dut):
                            p_reverse=0.3)
         task = cocotb.start_soon(walker.run(10 ** 9))
         await ClockCycles(dut.clk, rng.randint(100, 300))
-        await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
-        await env.settle()
-        t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
-        for k in rng.sample(range(n), min(n, 4)):
-            await check_snapshot(envs[k], walker.lines[k], t, None, f"after reset {rep}, channel {k}")
+        await global_snapshot(env, envs, walker, rng, None, f"after reset {rep}")
         task.cancel()
         await env.settle()
         for k, (e, m) in enumerate(zip(envs, models)):
