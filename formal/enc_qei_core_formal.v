@@ -328,7 +328,8 @@ module enc_qei_core_formal #(
     f_unf     = 1'b0;
     f_took    = 1'b0;
     f_stop_d  = f_stopped;
-    if (f_su) begin
+    // (stopped by non_recycle: no step in any range until a COUNT write)
+    if (f_su && !f_stopped) begin
       case (f_range)
         ENC_QEI_RANGE_FREE: begin
           f_stepped = f_count + ONE;
@@ -340,16 +341,14 @@ module enc_qei_core_formal #(
           f_ovf = f_at_ceil;
           f_took = 1'b1;
         end
-        default: begin  // limit, non_recycle (while not stopped)
-          if (f_range == ENC_QEI_RANGE_LIMIT || !f_stopped) begin
-            f_stepped = f_at_ceil ? f_count : f_count + ONE;
-            f_ovf = f_at_ceil;
-            f_took = ~f_at_ceil;
-            if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_ceil;
-          end
+        default: begin  // limit, non_recycle
+          f_stepped = f_at_ceil ? f_count : f_count + ONE;
+          f_ovf = f_at_ceil;
+          f_took = ~f_at_ceil;
+          if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_ceil;
         end
       endcase
-    end else if (f_sd) begin
+    end else if (f_sd && !f_stopped) begin
       case (f_range)
         ENC_QEI_RANGE_FREE: begin
           f_stepped = f_count - ONE;
@@ -362,12 +361,10 @@ module enc_qei_core_formal #(
           f_took = 1'b1;
         end
         default: begin
-          if (f_range == ENC_QEI_RANGE_LIMIT || !f_stopped) begin
-            f_stepped = f_at_zero ? f_count : f_count - ONE;
-            f_unf = f_at_zero;
-            f_took = ~f_at_zero;
-            if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_zero;
-          end
+          f_stepped = f_at_zero ? f_count : f_count - ONE;
+          f_unf = f_at_zero;
+          f_took = ~f_at_zero;
+          if (f_range == ENC_QEI_RANGE_NON_RECYCLE) f_stop_d = f_at_zero;
         end
       endcase
     end
@@ -488,12 +485,13 @@ module enc_qei_core_formal #(
       // a bounded range is never left by counting
       if ($past(f_range) != ENC_QEI_RANGE_FREE && $past(count) <= $past(f_ceil) && !$past(f_load))
         assert (count <= $past(f_ceil));
-      // limit / non_recycle: never past the bounds, the stop raises the event and is no step
+      // limit / non_recycle: never past the bounds, the stop raises the event and is no step (a
+      // counter stopped by non_recycle, in any range: no event either)
       if ($past(f_range) == ENC_QEI_RANGE_LIMIT || $past(f_range) == ENC_QEI_RANGE_NON_RECYCLE) begin
         if ($past(step_up) && $past(count) >= $past(f_ceil))
-          assert (!$past(applied_up) && $past(ev_overflow) == ($past(f_range) == ENC_QEI_RANGE_LIMIT || !$past(stopped)));
+          assert (!$past(applied_up) && $past(ev_overflow) == !$past(stopped));
         if ($past(step_dn) && !$past(step_up) && $past(count) == ZERO)
-          assert (!$past(applied_dn) && $past(ev_underflow) == ($past(f_range) == ENC_QEI_RANGE_LIMIT || !$past(stopped)));
+          assert (!$past(applied_dn) && $past(ev_underflow) == !$past(stopped));
       end
       // non_recycle: stopped stays stopped (and the count still) until a load
       if ($past(stopped) && !$past(f_lw_q)) assert (stopped);
@@ -523,6 +521,7 @@ module enc_qei_core_formal #(
   end
   always @(*) begin
     if (f_past_valid) assert (count == f_pos2);
+    if (f_past_valid) assert (!stopped);  // (the free range never stops; a stop would hold)
   end
   always @(posedge clk) begin
     cover (f_past_valid && count == 8'd3 && !rst);

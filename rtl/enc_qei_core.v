@@ -277,7 +277,8 @@ module enc_qei_core #(
   // from the next range, STOPPED, at-ceiling and zero values):
   //   up:   up_wrap    modulo at CEILING -> 0           down: dn_wrap_q  modulo at 0 -> CEILING
   //         up_lim     limit / non_recycle at CEILING         dn_lim_q   limit / non_recycle at 0
-  //         stop_q     non_recycle stopped: no step           (the same stop_q)
+  //         stop_q     non_recycle stopped: no step, no wrap, in any range until a COUNT write
+  //                    (the same stop_q)
   //         up_blk     = up_wrap | up_lim | stop_q            dn_blk_q = dn_wrap_q | dn_lim_q | stop_q
   // A free range blocks nothing (the count wraps by itself; overflow / underflow at the ends).
   wire [1:0] up_wrap_q, up_lim_q, up_blk_q;  // (each: partial flags, see parts() below)
@@ -420,7 +421,7 @@ module enc_qei_core #(
         end
       endfunction
 
-      wire       stop_n  = ~rst & (range == ENC_QEI_RANGE_NON_RECYCLE) & stopped_d;
+      wire       stop_n  = ~rst & stopped_d;  // (a stop holds in any RANGE until COUNT is written)
       wire [7:0] sel_mod = sel & {8{range == ENC_QEI_RANGE_MODULO}};                            // next: modulo
       wire [7:0] sel_lim = sel & {8{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
       wire [7:0] sel_bnd = sel & {8{range != ENC_QEI_RANGE_FREE}};                              // bounded
@@ -441,10 +442,10 @@ module enc_qei_core #(
       reg       dn_wrap_r, dn_lim_r, dn_blk_r, stop_r;
 
       always @(posedge clk) begin
-        up_wrap_r <= parts(late_mod, early_g[2]);
+        up_wrap_r <= parts(late_mod, early_g[2]) & {2{~stop_n}};  // (stopped: no wrap either)
         up_lim_r  <= parts(late_lim, early_g[1]);
         up_blk_r  <= parts(late_bnd, early_g[0]);
-        dn_wrap_r <= |(sel_mod & z_cand);
+        dn_wrap_r <= ~stop_n & (|(sel_mod & z_cand));
         dn_lim_r  <= |(sel_lim & z_cand);
         dn_blk_r  <= stop_n | (|(sel_bnd & z_cand));
         stop_r    <= stop_n;
@@ -623,11 +624,11 @@ module enc_qei_core #(
         assert (ceil_now_zero == (ceil_now == {COUNT_W{1'b0}}));
         assert (g_range.ceil_wrap_ge_q == (ceil_now >= f_nx));
         assert (load_ge_q == (load_val_q >= f_nx));
-        assert (stop_q == (r_nr & stopped_q));
-        assert (up_wrap == ((range_q == ENC_QEI_RANGE_MODULO) & f_at_ceil));
+        assert (stop_q == stopped_q);
+        assert (up_wrap == ((range_q == ENC_QEI_RANGE_MODULO) & f_at_ceil & ~stopped_q));
         assert (up_lim == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & f_at_ceil));
         assert (up_blk == (stop_q | (~r_free & f_at_ceil)));
-        assert (dn_wrap_q == ((range_q == ENC_QEI_RANGE_MODULO) & zero_q));
+        assert (dn_wrap_q == ((range_q == ENC_QEI_RANGE_MODULO) & zero_q & ~stopped_q));
         assert (dn_lim_q == (((range_q == ENC_QEI_RANGE_LIMIT) | r_nr) & zero_q));
         assert (dn_blk_q == (stop_q | (~r_free & zero_q)));
       end

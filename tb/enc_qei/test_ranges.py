@@ -166,6 +166,45 @@ async def steps_at_patterned_ceilings(dut):
             await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}, steps in consecutive clocks")
 
 
+@cocotb_test(skip=lacks("RANGE"))
+async def non_recycle_stop_holds(dut):
+    """non_recycle stopped at CEILING (and at 0): a RANGE change to free, modulo or limit does not
+    release it (steps both ways count nothing, STATUS.STOPPED stays 1), nor does an index preset;
+    a COUNT write does, and the new range counts from there. COUNT, EVENTS, STOPPED vs the model."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+
+    async def stopped(what, want):
+        await env.settle()
+        got = get_field("STATUS", "STOPPED", await bus.rd("STATUS"))
+        assert got == want == int(model.stopped), f"{what}: STATUS.STOPPED {got}, model {model.stopped}"
+
+    for other in ("free", "modulo", "limit"):
+        for start, d in ((7, 1), (3, -1)):  # up to CEILING 10, down to 0
+            await env.setup(model, rng_mode="non_recycle", filter_len=1, count=start, ceiling=10)
+            steps = [d] * 8
+            await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+            await env.check(model, f"non_recycle from {start}")
+            await stopped(f"non_recycle from {start}", 1)
+            ctrl = pack("CTRL", EN=1, FUNC="x4", RANGE=other, FILTER_LEN=1)
+            await bus.wr("CTRL", ctrl)
+            model.range = other
+            await env.applied()
+            steps = [1, 1, -1, -1, -1, 1]
+            await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+            await env.check(model, f"stopped, then RANGE {other}")
+            await stopped(f"stopped, then RANGE {other}", 1)
+            await bus.set_count(5)
+            model.write_count(5)
+            await env.applied()
+            await stopped("COUNT written", 0)
+            steps = [1, 1, -1]
+            await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
+            await env.check(model, f"COUNT written, RANGE {other}")
+    assert model.count == 6, f"the last walk counted to {model.count}, not 6"
+
+
 @cocotb_test()
 async def free_range_ignores_ceiling(dut):
     """RANGE free with CEILING set below the top (free ignores it): steps in consecutive clocks

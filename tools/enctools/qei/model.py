@@ -159,6 +159,8 @@ class QeiModel:
         if step != self.dir:
             self.events.add("DIR_CHANGE")
         self.dir = step
+        if self.stopped:  # non_recycle stopped it: no step, in any range, until COUNT is written
+            return
         c, r = self.count, self.range
         took = True
         if r == "free":
@@ -184,8 +186,6 @@ class QeiModel:
                 else:
                     c -= 1
         else:  # limit, non_recycle
-            if r == "non_recycle" and self.stopped:
-                return
             if step > 0 and c >= self.ceiling:
                 self.events.add("OVERFLOW")
                 took = False
