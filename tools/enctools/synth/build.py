@@ -17,8 +17,8 @@ from .. import core as core_file
 from ..paths import TOP
 from ..toolenv import tool
 from .blocks import (BLOCK_DEVICE, BLOCK_DEVICE_NAME, BLOCK_PINS, BOARD_BUILD, BOARD_CLOCK_MHZ, BUILD,
-                     CONSTRAINTS, ECP5_DEVICE, ECP5_PINS, FMAX_TARGET_MHZ, LATCH_CELLS, WAIVERS, Block,
-                     Result, fits)
+                     CONSTRAINTS, ECP5_DEVICE, ECP5_PINS, FMAX_TARGET_MHZ, LATCH_CELLS, PLACED_CELL, WAIVERS,
+                     Block, Result, fits)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -172,7 +172,8 @@ def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
         res.luts = cells.get("SB_LUT4", 0)
         res.carries = cells.get("SB_CARRY", 0)
         res.ffs = sum(n for c, n in cells.items() if c.startswith("SB_DFF"))
-    res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM"))
+    res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM") or c == "DP16KD")
+    res.lutrams = cells.get("TRELLIS_DPR16X4", 0)
     res.dsps = cells.get("SB_MAC16", 0)
     res.port_bits = stat["design"].get("num_port_bits", 0)
     if not block.pnr:
@@ -209,6 +210,9 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
     fmaxes = sorted(run.fmax for run in runs if run.fmax is not None)
     if fmaxes:
         res.fmax = fmaxes[len(fmaxes) // 2]
+        # packing does not depend on the seed; the median seed's count all the same
+        median = next(run for run in runs if run.fmax == res.fmax)
+        res.placed, res.placed_of = median.placed, median.placed_of
         res.clock_constraint = min(run.clock_constraint for run in runs if run.clock_constraint is not None)
 
 
@@ -254,6 +258,9 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
         res.status = "error"
         return False
     rep = json.loads(report.read_text())
+    used = rep.get("utilization", {}).get(PLACED_CELL.get(block.device, ""), {})
+    if used and not block.board:
+        res.placed, res.placed_of = used.get("used"), used.get("available")
     fmax = rep.get("fmax", {})
     if fmax:
         # one clock per design here; keep the slowest if there are more

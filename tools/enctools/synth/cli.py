@@ -59,7 +59,7 @@ from .. import core as core_file
 from ..paths import TOP
 from .blocks import BLOCKS, BUILD, CHANNELS_MD, RESULTS_MD, SEED, WAIVERS, Block, Result
 from .build import Waiver, load_waivers, merge_seeds, seed_run, synthesize
-from .channels import SWEEP_CHANNELS, SWEEP_DEVICES, SWEEP_PROFILES, channel_table, channels_markdown, sweep_block
+from .channels import SWEEP_CHANNELS, channel_table, channels_markdown, sweep_blocks
 from .report import changes, efifo_table, markdown, previous_rows, table
 
 
@@ -76,6 +76,17 @@ def parse_channels(text: str) -> list[int]:
     if len(values) < 2:
         raise argparse.ArgumentTypeError(f"at least two CHANNELS values for a line, not {text!r}")
     return values
+
+
+def parse_param(text: str) -> tuple[str, int]:
+    """`--param`: NAME=VALUE with an integer value."""
+    name, sep, value = text.partition("=")
+    try:
+        if not sep or not name:
+            raise ValueError
+        return name, int(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=integer, e.g. ENGINE=1, not {text!r}") from None
 
 
 def weight(b: Block) -> int:
@@ -158,6 +169,8 @@ def main() -> int:
     ap.add_argument("--bitstream", action="store_true", help="also pack build/icebreaker/icebreaker_top.bin")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     help="synthesize only these modules' rows (no channel table)")
+    ap.add_argument("--param", nargs="+", metavar="NAME=VALUE", type=parse_param, default=[],
+                    help="only the rows with these parameters, e.g. ENGINE=1 (no channel table)")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
     ap.add_argument("--quick", action="store_true",
                     help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
@@ -169,9 +182,11 @@ def main() -> int:
     args = ap.parse_args()
     if args.jobs < 1:
         ap.error(f"--jobs must be at least 1, not {args.jobs}")
-    if args.only and args.table in ("both", "channels"):
-        ap.error("--only picks rows of the first table; the channel table runs without it (--table channels)")
-    table_kind = args.table or ("blocks" if args.only or args.quick else "both")
+    picked = args.only or args.param
+    if picked and args.table in ("both", "channels"):
+        ap.error("--only and --param pick rows of the first table; the channel table runs without them "
+                 "(--table channels)")
+    table_kind = args.table or ("blocks" if picked or args.quick else "both")
     if args.channels and table_kind == "blocks":
         ap.error("--channels sets the channel table, which this run does not make (--table both or channels)")
     channels = args.channels or list(SWEEP_CHANNELS)
@@ -182,11 +197,14 @@ def main() -> int:
         if unknown:
             ap.error(f"unknown module(s): {', '.join(sorted(unknown))}")
         blocks = [b for b in BLOCKS if b.name in args.only]
+    if args.param:
+        blocks = [b for b in blocks if all(b.params.get(k) == v for k, v in args.param)]
+        if not blocks:
+            ap.error("no row has " + ", ".join(f"{k}={v}" for k, v in args.param))
     if args.quick:
         blocks = [Block(**{**b.__dict__, "seeds": 1, "params": {**b.params, **b.quick}})
                   for b in blocks if b.quick is not None]
-    sweep = ([sweep_block(prof, n, dev) for prof in SWEEP_PROFILES for dev in SWEEP_DEVICES for n in channels]
-             if table_kind != "blocks" else [])
+    sweep = sweep_blocks(channels) if table_kind != "blocks" else []
     # a build that is both a row and a point of the channel table is synthesised once, as the row
     keys = {b.key for b in blocks}
     if len(keys) != len(blocks):
@@ -199,7 +217,7 @@ def main() -> int:
     t0 = time.monotonic()
     results = run_jobs(jobs, waivers, args.bitstream, args.jobs)
     ordered = [results[b.key] for b in blocks]
-    write = not args.only and not args.quick
+    write = not picked and not args.quick
     if blocks:
         print()
         print(table(ordered))
@@ -222,7 +240,7 @@ def main() -> int:
         print("\n".join(diff))
     failures = [f for r in results.values() for f in r.failures]
     for v in waivers:
-        if not v.used and not args.only:
+        if not v.used and not picked:
             print(f"synth: note: waiver at {WAIVERS.name}:{v.line} matched nothing this run")
     print(f"synth: {len(jobs)} builds in {time.monotonic() - t0:.0f} s")
     if failures:

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .blocks import (BLOCK_DEVICE_NAME, BOARD_CLOCK_MHZ, CAPACITY, CHANNELS_MD, ECP5_DEVICE_NAME,
-                     FMAX_TARGET_MHZ, SEED, Result)
+from .blocks import (BLOCK_DEVICE_NAME, BOARD_CLOCK_MHZ, BRAM_CAPACITY, BRAM_CELL, CAPACITY, CHANNELS_MD,
+                     ECP5_DEVICE_NAME, FMAX_TARGET_MHZ, PLACED_CELL, SEED, Result)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -40,23 +40,38 @@ def goal_cells(r: Result) -> tuple[str, str]:
     return ", ".join(goals), ("met" if all(v == "met" for v in verdicts) else ", ".join(verdicts))
 
 
+def ram_cell(r: Result) -> str:
+    """The build's block RAMs (and the ECP5's distributed RAM), or -."""
+    out = [f"{r.brams} {BRAM_CELL[r.block.device]}" if r.brams else "",
+           f"{r.lutrams} DPR16X4" if r.lutrams else ""]
+    return " + ".join(o for o in out if o) or "-"
+
+
+def placed_cell(r: Result) -> str:
+    """The LUT4 sites nextpnr used (iCE40 logic cells, ECP5 TRELLIS_COMB) of the part's, or -."""
+    if r.placed is None:
+        return "-"
+    unit = "LC" if PLACED_CELL[r.block.device] == "ICESTORM_LC" else "COMB"
+    return f"{r.placed:,} / {r.placed_of:,} {unit}"
+
+
 def table(results: list[Result]) -> str:
-    rows = ["| module | params | part | LUT4 | FF | carry | Fmax (MHz) | seeds | goal | result |",
-            "|---|---|---|---:|---:|---:|---:|---:|---|---|"]
+    rows = ["| module | params | part | LUT4 | FF | carry | Fmax (MHz) | seeds | block RAM | placed | goal | result |",
+            "|---|---|---|---:|---:|---:|---:|---:|---|---:|---|---|"]
     for r in results:
         b = r.block
         part = b.part
         if r.status != "ok":
-            rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {b.seeds} | {goal_cells(r)[0]} | {r.note} |")
+            rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {b.seeds} | - | - | "
+                        f"{goal_cells(r)[0]} | {r.note} |")
             continue
         fmax = (f"{r.fmax:.1f}" if r.fmax is not None else
                 "not placed (does not fit)" if not r.fits else "n/a (no clocked path)")
         goal, verdict = goal_cells(r)
-        extra = [f"{r.dsps} SB_MAC16" if r.dsps else "", f"{r.brams} SB_RAM40" if r.brams else ""]
-        if any(extra):
-            verdict += "; " + ", ".join(e for e in extra if e)
+        if r.dsps:
+            verdict += f"; {r.dsps} SB_MAC16"
         rows.append(f"| {b.name} | {b.param_text} | {part} | {r.luts} | {r.ffs} | {r.carries} | {fmax} "
-                    f"| {b.seeds} | {goal} | {verdict} |")
+                    f"| {b.seeds} | {ram_cell(r)} | {placed_cell(r)} | {goal} | {verdict} |")
     return "\n".join(rows)
 
 
@@ -98,10 +113,15 @@ def markdown(results: list[Result]) -> str:
         f"ECP5 rows: `synth_ecp5` + nextpnr-ecp5, {ECP5_DEVICE_NAME}. "
         "LUT4 = SB_LUT4 (iCE40) or LUT4 (ECP5) cells after synthesis (carry-chain LUTs included on "
         "iCE40), FF = SB_DFF* / TRELLIS_FF cells, carry = SB_CARRY / CCU2C. Fmax: median over the "
-        "seeds shown. A build with more LUT4 or flip-flops than its part holds "
-        f"({CAPACITY['hx8k']:,} logic cells on the HX8K; {CAPACITY['ecp5']:,} LUT4 on the LFE5U-25F, "
-        "where each CCU2C takes two more) is not placed. LUT4 versus CHANNELS, with the cost of one "
-        "more channel: "
+        "seeds shown. Block RAM: SB_RAM40_4K / DP16KD cells, and the ECP5's distributed RAM "
+        "(TRELLIS_DPR16X4, 16 x 4 bits in the LUTs of a slice, not in the LUT4 column). Placed: the "
+        "LUT4 sites nextpnr used after packing (iCE40 logic cells, ECP5 TRELLIS_COMB: LUT4, carry "
+        "and distributed RAM) of the part's. A build with more LUT4, flip-flops or block RAMs than "
+        f"its part holds ({CAPACITY['hx8k']:,} logic cells and {BRAM_CAPACITY['hx8k']} SB_RAM40_4K on "
+        f"the HX8K; {CAPACITY['ecp5']:,} LUT4, where each CCU2C takes two more, and "
+        f"{BRAM_CAPACITY['ecp5']} DP16KD on the LFE5U-25F) is not placed. ENGINE=1: the channels "
+        "share one engine (rtl/enc_qei_engine.v); without it, a datapath per channel. LUT4 versus "
+        "CHANNELS for both, with the cost of one more channel: "
         f"[{CHANNELS_MD.name}]({CHANNELS_MD.name}).",
         "",
         table(results),
