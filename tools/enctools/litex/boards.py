@@ -78,6 +78,7 @@ class Board:
                           # SPI flash at FLASH_OFFSET) or "" (none)
     engine: int = 0       # enc_qei's ENGINE
     sram_size: int = 0x10000
+    fw_snapshots: int = 0  # sw/soc's ENC_FW_SNAPSHOTS (its records take SRAM), 0: its default
     spiflash: tuple = ()  # (cs_n, clk, mosi, miso) pins, for firmware "flash"
 
 
@@ -94,8 +95,8 @@ BOARDS = {
         COLORLIGHT_AB[:8], "full", "lean", 32, 60_000_000, 0x4000, "bram", "rom"),
     "colorlight_i5_engine": Board(
         "colorlight_i5_engine", "LFE5U-25F-6BG381C", "trellis", COLORLIGHT_CLK, COLORLIGHT_SERIAL,
-        COLORLIGHT_AB, "full", "full", 32, 60_000_000, 0x4000, "bram", "rom", engine=1,
-        sram_size=0x8000),
+        COLORLIGHT_AB, "lite", "full", 32, 60_000_000, 0x4000, "bram", "rom", engine=1,
+        sram_size=0x4000, fw_snapshots=20),
 }
 
 
@@ -206,7 +207,7 @@ def build(board: Board) -> dict:
         old.unlink()  # a bitstream of an earlier build is not this one's
     fw_bytes = None
     if board.firmware:
-        fw = _firmware(out)
+        fw = _firmware(out, board.fw_snapshots)
         fw_bytes = fw.stat().st_size
         if board.firmware == "rom":
             rom = next(gw.glob("*_rom.init"))
@@ -240,11 +241,12 @@ def build(board: Board) -> dict:
     return res
 
 
-def _firmware(out):
+def _firmware(out, snapshots: int):
     fw_dir = out / "firmware"
     fw_dir.mkdir(exist_ok=True)
-    r = subprocess.run(["make", "-s", "-C", str(fw_dir), "-f",
-                        str(simsoc.FIRMWARE_SRC / "Makefile"), f"BUILD_DIR={out}"],
+    r = subprocess.run(["make", "-s", "-B", "-C", str(fw_dir), "-f",
+                        str(simsoc.FIRMWARE_SRC / "Makefile"), f"BUILD_DIR={out}",
+                        *([f"FW_SNAPSHOTS={snapshots}"] if snapshots else [])],
                        capture_output=True, text=True)
     if r.returncode != 0:
         raise SystemExit(f"soc-bitstream: firmware build failed:\n{r.stdout}{r.stderr}")
@@ -279,9 +281,12 @@ def _row(board: Board, res: dict) -> str:
     if not res.get("fits", True):
         logic = f"**does not fit**: {logic}"
     kb = f"{res['firmware_bytes'] / 1024:.1f} KiB" if res.get("firmware_bytes") else ""
+    if board.fw_snapshots:
+        kb += f", {board.fw_snapshots} snapshots"
     fw = {"rom": f"sw/soc in ROM ({kb})",
           "flash": f"sw/soc in SPI flash at {FLASH_OFFSET:#x} ({kb}), run in place",
           "": "none"}[board.firmware]
+    fw += f"; {board.sram_size // 1024} KiB SRAM"
     fmax = f"{res['fmax']:.1f}" if res["fmax"] else "—"
     arch = ", shared engine" if board.engine else ""
     return (f"| {board.name} | {board.device} | VexRiscv {board.cpu_variant} | "

@@ -8,8 +8,9 @@ iCE40UP5K-SG48 of the iCEBreaker, with the pin file and the 12 MHz clock constra
 boards/icebreaker/ (there the clock constraint must be met, not just reported). Blocks marked for
 ECP5 also go through Yosys `synth_ecp5` and nextpnr-ecp5 on an LFE5U-25F (CABGA256). Rows with
 several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core. A build
-with more LUT4 or flip-flops than its part holds is not placed: its row shows the synthesis counts
-and "does not fit".
+with more LUT4, flip-flops or block RAMs than its part holds is not placed: its row shows the
+synthesis counts and "does not fit"; a placed row shows the logic cells (ECP5: TRELLIS_COMB)
+nextpnr used.
 
 The table (module, parameters, LUT4, flip-flops, SB_CARRY, Fmax, goal, met / missed by) is printed
 and written to doc/results/synth_results.md. A block whose rtl/ file does not exist yet gets a
@@ -17,11 +18,12 @@ and written to doc/results/synth_results.md. A block whose rtl/ file does not ex
 run replaces are listed at the end of the output.
 
 The channel table: enc_qei_wb (COUNT_W 32) with CHANNELS 1, 2, 4, 8 and 16 in the lean and the full
-profile, synthesis only (Yosys `synth_ice40` and `synth_ecp5`; no place and route), and the
-least-squares line LUT4 = intercept + slope x CHANNELS through each row: the intercept is the bus,
-the register decode and the global units, the slope what one more channel costs. Printed and
-written to doc/results/synth_channels.md. A build that is also a row of the first table is
-synthesised once.
+profile and in both architectures (ENGINE 0: a datapath per channel; ENGINE 1: one shared engine),
+synthesis only (Yosys `synth_ice40` and `synth_ecp5`; no place and route): LUT4, flip-flops and
+block RAMs, and the least-squares line LUT4 = intercept + slope x CHANNELS through each row: the
+intercept is the bus, the register decode, the global units (and the engine), the slope what one
+more channel costs. Printed and written to doc/results/synth_channels.md. A build that is also a
+row of the first table is synthesised once.
 
 The run fails (exit 1) on
   - any latch left after `proc` (`select -assert-none t:$dlatch ...`),
@@ -34,10 +36,13 @@ Options:
   --bitstream        also run icepack: build/icebreaker/icebreaker_top.bin (`make bitstream`)
   --only NAME ...    just these modules' rows of the first table (no channel table; the table
                      file is not rewritten)
+  --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
+                     shared engine's rows); as --only, no table file is rewritten
   --jobs N           parallel tool runs (default 2)
-  --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels:
-                     2) or left out (8 full on the ECP5), no channel table (CI: checks the flow,
-                     not the figures; no table file is rewritten)
+  --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels,
+                     per channel and shared engine: 2) or left out (8 full on the ECP5, the other
+                     engine rows), no channel table (CI: checks the flow, not the figures; no
+                     table file is rewritten)
   --table WHICH      blocks, channels or both (default: both; blocks with --only or --quick)
   --channels N,N,..  the CHANNELS of the channel table (default 1,2,4,8,16; the table file is
                      rewritten only for the default)
