@@ -13,6 +13,9 @@
 //     unmapped read or a write 0;
 //   - outside resp_valid, resp_err and resp_rdata take any value at every clock (the adapters
 //     must not look at them then); irq and cmp_out are free as well.
+// The adapters pass ENGINE on; this stand-in answers as the per_channel build (ENGINE 0) does,
+// so the adapter proofs are of that build (a shared engine answers 4 or more clocks after a
+// request).
 // It asserts the one rule enc_qei sets its user (rtl/enc_qei_regs.v): one request at a time, a
 // new one only from the clock after the previous one's resp_valid.
 `default_nettype none
@@ -25,7 +28,8 @@ module enc_qei #(
     parameter integer TS_W       = 32,
     parameter integer PROFILE    = 2,
     parameter integer FUNC_MASK  = `ENC_QEI_FUNC_ALL,
-    parameter integer EFIFO_LOG2 = 0
+    parameter integer EFIFO_LOG2 = 0,
+    parameter integer ENGINE     = 0   // taken, not modelled: the answers are per_channel's (ENGINE 0)
 ) (
     input  wire        clk,
     input  wire        rst,

@@ -132,7 +132,7 @@ async def isolation(dut):
 
 @cocotb_test()
 async def channel_map(dut):
-    """CAPS names the channels and the profile; every page below CHANNELS answers its channel
+    """CAPS names the channels, the profile and the architecture (ENGINE); every page below CHANNELS answers its channel
     registers, a global offset in a page other than 0 and every page at or above CHANNELS answer
     a bus error; IRQ_SUMMARY bits at and above CHANNELS read 0."""
     envs, rng = await start_channels(dut)
@@ -142,6 +142,8 @@ async def channel_map(dut):
     assert get_field("CAPS", "CHANNELS", caps) == n, f"CAPS {caps:#x}: CHANNELS is not {n}"
     profile = {v: k for k, v in enum("CAPS", "PROFILE").items()}[get_field("CAPS", "PROFILE", caps)]
     assert profile == PROFILE_OF[int(dut.PROFILE.value)], f"CAPS.PROFILE {profile}"
+    arch = {v: k for k, v in enum("CAPS", "ENGINE").items()}[get_field("CAPS", "ENGINE", caps)]
+    assert arch == ("shared" if int(dut.ENGINE.value) else "per_channel"), f"CAPS.ENGINE {arch}"
     version = get_field("ID", "VERSION", await bus.rd("ID"))
     assert version >= 0x0101, f"ID.VERSION {version:#06x}: a multi-channel map is 0x0101 or later"
     pages = 1 << (int(dut.ADDR_W.value) - 8)  # the pages the address reaches

@@ -221,12 +221,12 @@ async def steps_in_consecutive_clocks(dut):
     """Every RANGE, CEILINGs of 0, small ones and ones with high bits: from counts at, just above
     and just below CEILING, at 0 and at the top, steps in consecutive clocks both ways (an up step
     right after a down step, a wrap right after a wrap, ...): COUNT, EVENTS and STATUS.STOPPED
-    equal the model's after each burst."""
+    equal the model's after each burst. (A lean build's count is free-running: free only.)"""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
     top = model.max
-    for mode in ("modulo", "limit", "non_recycle", "free"):
+    for mode in ("free",) if env.lean else ("modulo", "limit", "non_recycle", "free"):
         for ceiling in (ceilings(env.count_w) if mode != "free" else [top]):
             await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
             starts = near([ceiling + d for d in (-1, 0, 1, 2)] + [0, top], 0, top)
@@ -280,6 +280,6 @@ async def en_off_gates_steps_only(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_counting(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_counting(config):
+    run_feature(__name__, *config)

@@ -14,9 +14,15 @@ GSNAP_CTRL / GSNAP_PERIOD say it:
   at the old length, the next ones at the new; a write whose snapshot clock is less than
   PERIOD_LAG clocks before the end of the period in progress applies one period later.
 
+With the shared engine (ENGINE = 1) the global snapshot is the same, but a channel's own
+SNAP_CTRL.CMD is taken at the engine's next read of the channel, within P + 18 clocks of the
+write clock (P = 24 x max(CHANNELS, 2), the clocks between two reads), and a global snapshot
+requested while the capture of the one before still waits for its visit is taken when it no
+longer waits (at most P clocks after the one before; requests meanwhile make one snapshot).
+
 The times are taken from the design: the timebase (TB_PRESCALE 0: one tick per clock) and the
-bus handshakes in every clock, and the global snapshot requests (the snapshot clocks). Runs on
-both builds of enctools.qei.env.CONFIGS, with random AXI4-Lite back-pressure.
+bus handshakes in every clock, and the global snapshots (the snapshot clocks). Runs on the builds
+of enctools.qei.env.CONFIGS, with random AXI4-Lite back-pressure.
 """
 
 from __future__ import annotations
@@ -27,7 +33,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.env import ENGINE_ACT, CONFIG_IDS, CONFIGS, begin, engine_period, run_feature
 from enctools.regmap import pack
 from enctools.tb import cocotb_test
 
@@ -94,12 +100,33 @@ async def write(bus, trace: Trace, reg: str, value: int) -> tuple[int, int]:
     return trace.write_clock(n0), trace.first("resp", n0)
 
 
+def check_deferred(requests, taken, p, what) -> None:
+    """The shared engine's global snapshots: each request (a clock) is taken in its clock, or,
+    while the capture of the snapshot before (at most p clocks before) waits for its visit, in
+    the clock it is free (at most p clocks after that one); requests meanwhile make one snapshot;
+    no snapshot without a request."""
+    used = set()
+    for r in sorted(requests):
+        t = next((i for i in taken if i >= r), None)
+        before = [i for i in taken if i < r]
+        assert t is not None, f"{what}: no snapshot for the request in clock {r}"
+        if t != r:
+            assert before and r - before[-1] <= p and t <= before[-1] + p, \
+                f"{what}: the request in clock {r} taken in clock {t} (the snapshot before: " \
+                f"{before[-1] if before else None}, P {p})"
+        used.add(t)
+    assert used == set(taken), f"{what}: snapshots without a request: {sorted(set(taken) - used)}"
+
+
 @cocotb_test()
 async def cmd_snapshot_clock(dut):
     """GSNAP_CTRL.CMD and a channel's SNAP_CTRL.CMD, twelve writes each at random distances:
     the snapshot clock (where GSNAP_TIME / SNAP_TIME take the timebase) is the write clock +
-    WB_LAT or AXIL_LAT, the clock of the Wishbone acknowledge or the one before BVALID."""
+    WB_LAT or AXIL_LAT, the clock of the Wishbone acknowledge or the one before BVALID (with the
+    shared engine, writes P clocks further apart, and SNAP_CTRL.CMD: from the write clock + that
+    to the write clock + P + 18)."""
     env, rng = await begin(dut)
+    channels = int(dut.CHANNELS.value)
     bus = env.bus
     await bus.wr("TB_PRESCALE", 0)
     trace = Trace(dut)
@@ -107,13 +134,18 @@ async def cmd_snapshot_clock(dut):
     found = {}
     for reg, time_reg in (("GSNAP_CTRL", "GSNAP_TIME"), ("SNAP_CTRL", "SNAP_TIME")):
         for _ in range(12):
-            await ClockCycles(dut.clk, rng.randint(1, 30))
+            # (the shared engine: after the capture of the snapshot before was visited)
+            await ClockCycles(dut.clk, rng.randint(1, 30) + env.engine * engine_period(channels))
             n0 = trace.now()
             wclk, rclk = await write(bus, trace, reg, pack(reg, CMD=1))
             snap = trace.clock_of(await bus.rd(time_reg), n0)
             found.setdefault(reg, set()).add((snap - wclk, rclk - snap))
     dut._log.info("snapshot clock - write clock, response clock - snapshot clock: %s", found)
     for reg, seen in found.items():
+        if env.engine and reg == "SNAP_CTRL":
+            d = sorted(d for d, _ in seen)
+            assert lat <= d[0] and d[-1] <= engine_period(channels) + ENGINE_ACT, f"{reg}.CMD: {seen}"
+            continue
         assert seen == {(lat, RESP[trace.wb])}, f"{reg}.CMD: {seen}"
 
 
@@ -122,8 +154,9 @@ async def period_en_rewrite_and_restart(dut):
     """The unit timer at GSNAP_PERIOD P: PERIOD_EN written 1 again (and CMD with it) at random
     phases keeps every timer snapshot on the grid of the first one, P clocks apart; PERIOD_EN
     written 0 and then 1 restarts it, the first snapshot P clocks after the write's snapshot
-    clock."""
+    clock. (The shared engine: a snapshot may be deferred, check_deferred.)"""
     env, rng = await begin(dut)
+    channels = int(dut.CHANNELS.value)
     bus = env.bus
     await bus.wr("TB_PRESCALE", 0)
     trace = Trace(dut)
@@ -141,11 +174,19 @@ async def period_en_rewrite_and_restart(dut):
         await ClockCycles(dut.clk, 2 * period)
         end = trace.now()
         cmds = {c for c, with_cmd in rewrites if with_cmd}
-        timer = [i for i in trace.snapshots(start + 1, end) if i not in cmds]
-        assert len(timer) >= 5
-        assert [i - start for i in timer] == [period * (k + 1) for k in range(len(timer))], \
-            f"period {period}: timer snapshots at {[i - start for i in timer]} clocks after the " \
-            f"start; PERIOD_EN rewritten at {[c - start for c, _ in rewrites]}"
+        if env.engine:  # the timer's grid and the commands, some of them deferred
+            grid = range(start + period, end - engine_period(channels), period)
+            assert len(grid) >= 5
+            taken = [i for i in trace.snapshots(start + 1, end) if i < grid[-1] + period // 2]
+            check_deferred(set(grid) | cmds, taken, engine_period(channels),
+                           f"period {period}, PERIOD_EN rewritten at {[c - start for c, _ in rewrites]} "
+                           f"clocks after the start (snapshots at {[i - start for i in taken]})")
+        else:
+            timer = [i for i in trace.snapshots(start + 1, end) if i not in cmds]
+            assert len(timer) >= 5
+            assert [i - start for i in timer] == [period * (k + 1) for k in range(len(timer))], \
+                f"period {period}: timer snapshots at {[i - start for i in timer]} clocks after " \
+                f"the start; PERIOD_EN rewritten at {[c - start for c, _ in rewrites]}"
         # 0, then 1: a restart
         await ClockCycles(dut.clk, rng.randint(1, period))
         await bus.wr("GSNAP_CTRL", 0)
@@ -211,9 +252,9 @@ async def new_period_after_the_one_in_progress(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_gsnap_timing(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_gsnap_timing(config):
+    run_feature(__name__, *config)
 
 
 def test_doc_and_rdl_say_the_measured_clocks():

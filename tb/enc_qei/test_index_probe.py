@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei index and probe: INDEX_CTRL actions (preset, latch, none), the gate, one-shot, edges,
 the latches with wide values, index edges at steps and wraps; PROBE_CTRL, PROBE_LATCH and
-PROBE_TIME; which configuration changes are not index edges.
+PROBE_TIME; which configuration changes are not index edges. A lean build has no probe unit and a
+free-running count: its index tests run in the free range (wraps at 0 and the top).
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -15,7 +16,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, Timer
 from hedsmodel import QUAD, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, lacks, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import (WIDE, ceilings, durations, near, play_clocks, slice_compare_cases,
                                    step_clocks)
@@ -81,6 +82,7 @@ async def index_gate_same_position(dut):
     gate = QUAD[6 % 4]
     await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", GATE_EN=1, GATE_A=gate[0],
                                     GATE_B=gate[1], ARM=1))
+    await env.applied()
     zf = lambda p: int(5 <= p <= 7)  # noqa: E731
     for direction in (1, -1, 1, -1):
         target = 12 if direction > 0 else 0
@@ -92,7 +94,7 @@ async def index_gate_same_position(dut):
         assert got == 500 + (target - 6), f"direction {direction}: count {got}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("PROBE"))
 async def probe(dut):
     """PROBE_CTRL: the count and the timebase at the chosen edge; ONCE clears EN."""
     env, rng = await begin(dut)
@@ -129,15 +131,18 @@ async def probe(dut):
 
 @cocotb_test()
 async def latches_wide(dut):
-    """PROBE_LATCH and INDEX_LATCH of counts with every bit pattern (the high word too)."""
+    """PROBE_LATCH and INDEX_LATCH of counts with every bit pattern (the high word too; a lean
+    build: INDEX_LATCH)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
+    probe = not lacks("PROBE")
     for value in WIDE + tuple(~v for v in WIDE):
         value &= model.max
         await env.setup(model, count=value)
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
         await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="latch", EDGE="rising", ARM=1))
+        await env.applied()
         dut.probe_in.value = 1
         dut.z_in.value = 1
         await env.settle(10)
@@ -145,9 +150,10 @@ async def latches_wide(dut):
         dut.z_in.value = 0
         await env.settle(10)
         for gap in (1, 2, 0):  # held: the same value at reads an odd and an even clock apart
-            probe = await bus.rd("PROBE_LATCH_LO") | await bus.rd("PROBE_LATCH_HI") << 32
+            if probe:
+                got = await bus.rd("PROBE_LATCH_LO") | await bus.rd("PROBE_LATCH_HI") << 32
+                assert got == value, f"PROBE_LATCH {got:#x}, count {value:#x}"
             index = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
-            assert probe == value, f"PROBE_LATCH {probe:#x}, count {value:#x}"
             assert index == value, f"INDEX_LATCH {index:#x}, count {value:#x}"
             await ClockCycles(dut.clk, gap) if gap else None
         await bus.wr("PROBE_CTRL", 0)
@@ -185,14 +191,15 @@ async def index_at_steps(dut):
     """An index preset in the clock right before steps in consecutive clocks (PRESET at, just above
     and just below CEILING, also in another 16-bit slice), and an index latch in the very clock of
     a wrap (down from 0 to CEILING, up from CEILING to 0) or of a step: COUNT, EVENTS and
-    INDEX_LATCH equal the model's, in every bounded range."""
+    INDEX_LATCH equal the model's, in every bounded range (a lean build: in the free range, its
+    wraps at 0 and the top)."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
     top = model.max
     for action in ("preset", "latch"):
-        for mode in ("modulo", "limit", "non_recycle"):
-            for ceiling in ceilings(env.count_w, zero=False):
+        for mode in ("free",) if env.lean else ("modulo", "limit", "non_recycle"):
+            for ceiling in [top] if env.lean else ceilings(env.count_w, zero=False):
                 await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
                 await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
                 model.idx_action, model.idx_oneshot, model.idx_edge = action, False, "rising"
@@ -239,7 +246,7 @@ async def index_at_steps(dut):
                 model.idx_action = "none"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("PROBE"))
 async def probe_time_exact(dut):
     """PROBE_TIME at probe edges spread over the timebase's low bits: within the TIMEBASE values
     read just before and just after, and PROBE_LATCH the count, every time."""
@@ -251,6 +258,7 @@ async def probe_time_exact(dut):
         value = (0x0F0F_0F0F_5A5A_A5A5 >> k | 1 << 2 * k) & model.max
         await env.setup(model, count=value)
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
+        await env.applied()
         await Timer((73 * k + 5) * PERIOD_PS, unit="ps")
         await FallingEdge(dut.clk)
         before = await bus.rd("TIMEBASE")
@@ -339,6 +347,7 @@ async def ctrl_change_is_not_an_index_edge(dut):
         await bus.set_count(count2)
         if gate is not None and edge == "falling":
             await bus.wr("CTRL", ctrl(option, v0))
+        await env.applied()  # (the shared engine: the writes act before the Z edge)
         await FallingEdge(dut.clk)
         dut.z_in.value = 1 - z
         await ClockCycles(dut.clk, 3)
@@ -361,12 +370,13 @@ async def index_preset_at_wraps(dut):
     """An index preset in the very clock of a step at a bound (up from CEILING, down from 0: a
     wrap in modulo, a blocked step in limit and non_recycle), then a step in the next clock, in
     every bounded range: the load wins, and the next step starts from the preset value (the
-    at-zero and at-CEILING flags computed for that clock are the preset's, not the wrap's)."""
+    at-zero and at-CEILING flags computed for that clock are the preset's, not the wrap's). A lean
+    build: in the free range (CEILING the top)."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
-    for mode in ("modulo", "limit", "non_recycle"):
-        for ceiling in (0x25, 0x0800_0040):
+    for mode in ("free",) if env.lean else ("modulo", "limit", "non_recycle"):
+        for ceiling in (model.max,) if env.lean else (0x25, 0x0800_0040):
             await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
             await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
             model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
@@ -392,30 +402,32 @@ async def z_and_probe_filter_lengths(dut):
     """Z and probe_in go through a filter of CTRL.FILTER_LEN samples like A and B: at FILTER_LEN
     4 .. 7 and 12 .. 15 (bit 2 set) and 8, a pulse of FILTER_LEN - 1 clocks is rejected (no INDEX,
     no PROBE event) and one of FILTER_LEN + 1 clocks is taken (INDEX on its rising edge, PROBE
-    with PROBE_CTRL on rising edges)."""
+    with PROBE_CTRL on rising edges; a lean build: Z only)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
+    pins = ((dut.z_in, "INDEX"),) + (() if lacks("PROBE") else ((dut.probe_in, "PROBE"),))
     for f in (4, 5, 6, 7, 8, 12, 15):
         await env.setup(model, filter_len=f)
         await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1, EDGE="rising"))
-        for sig, event in ((dut.z_in, "INDEX"), (dut.probe_in, "PROBE")):
+        for sig, event in pins:
             for clocks, taken in ((f - 1, False), (f + 1, True)):
                 await bus.events()
+                await env.applied()
                 await FallingEdge(dut.clk)
                 sig.value = 1
                 await ClockCycles(dut.clk, clocks)
                 await FallingEdge(dut.clk)
                 sig.value = 0
-                await ClockCycles(dut.clk, 2 * f + 8)
+                await env.settle(2 * f + 8)
                 ev = await bus.events()
                 assert (event in ev) == taken, \
                     f"FILTER_LEN {f}: a {clocks}-clock pulse on {event}: events {sorted(ev)}"
     await bus.wr("PROBE_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def index_preset_slice_compares(dut):
     """An index preset of a PRESET below, at or above CEILING, differing in one 16-bit slice above the
     lowest (the preset is compared with CEILING slice by slice for the range), in modulo, then
@@ -433,6 +445,7 @@ async def index_preset_slice_compares(dut):
         model.ceiling = ceiling
         for preset in presets:
             await bus.set64("PRESET", preset)
+            await env.applied()
             model.preset = preset
             await play_clocks(env, model, step_clocks(env.pos, (+1, +1, -1, 0), (1, 0, 0, 0)))
             await env.settle(4)
@@ -442,6 +455,6 @@ async def index_preset_slice_compares(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_index_probe(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_index_probe(config):
+    run_feature(__name__, *config)

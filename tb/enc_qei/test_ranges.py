@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei range modes (free, modulo, limit, non_recycle) and CEILING: across the bounds both
 ways, CEILINGs with every bit pattern, bounded ranges at the count-rate bound, step pairs and
-bursts of steps in consecutive clocks at the bounds.
+bursts of steps in consecutive clocks at the bounds. A lean build's count is free-running (RANGE
+reads free, CEILING is absent): it runs the free range's tests only.
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -16,7 +17,7 @@ import pytest
 from hedsmodel import random_walk, walk
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, lacks, run_feature
 from enctools.qei.model import RANGES, QeiModel
 from enctools.qei.stimulus import BURST, WIDE, durations, near, slice_compare_cases, steps_from
 from enctools.regmap import get_field, pack, regmap
@@ -29,7 +30,7 @@ async def range_modes(dut):
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
-    for mode in RANGES:
+    for mode in ("free",) if env.lean else RANGES:
         ceiling = rng.randint(5, 12) if mode != "free" else model.max
         start_count = 2 if mode != "free" else model.max - 2
         await env.setup(model, func="x4", rng_mode=mode, count=start_count, ceiling=ceiling)
@@ -54,7 +55,7 @@ async def range_modes(dut):
         dut._log.info("%s ok (ceiling %d)", mode, ceiling)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def ceiling_wide(dut):
     """RANGE modulo and limit with CEILINGs of varied bit patterns: across the top both ways, and
     from counts just above and below it in each 16-bit slice (the slices are compared apart)."""
@@ -78,7 +79,7 @@ async def ceiling_wide(dut):
                 await env.check(model, f"{mode} CEILING {ceiling:#x} from {start:#x}")
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def bounded_range_fast(dut):
     """RANGE modulo and limit at the count-rate bound (FILTER_LEN 1, states of 1.05 .. 2.1 clocks,
     many reversals: steps in consecutive clocks both ways), CEILINGs with high bits, counts on
@@ -119,7 +120,7 @@ def _pair_ceilings(count_w):
     return [0, 1, 0x8000_8021]
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def step_pairs_at_bounds(dut):
     """Two steps in consecutive clocks (down-up, up-down, up-up) from counts at, just above and
     just below CEILING and at 0 / 1, every bounded range, CEILING 0 and 1 too: COUNT, EVENTS and
@@ -141,7 +142,7 @@ async def step_pairs_at_bounds(dut):
                     assert stopped == int(model.stopped), f"{what}: STATUS.STOPPED {stopped}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def steps_at_patterned_ceilings(dut):
     """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
     list every run), each range, counts one step and one or five units of a 16-bit slice away:
@@ -178,7 +179,7 @@ async def free_range_ignores_ceiling(dut):
             await env.check(model, f"free, CEILING {ceiling:#x}, from {start:#x}")
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def single_bit_ceilings(dut):
     """CEILING = 2^k and 2^k + 1 for every bit k above 0, in modulo and limit: steps in
     consecutive clocks from 0 up and back down across 0 (the "CEILING <= 1" flag of the next
@@ -195,7 +196,7 @@ async def single_bit_ceilings(dut):
                 await env.check(model, f"{mode} CEILING {ceiling:#x}, steps from 0")
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("RANGE"))
 async def ceiling_slice_compares(dut):
     """COUNT loaded just below or above CEILING in one 16-bit slice above the lowest (the count
     compares with CEILING slice by slice: a >= b from the slices' > and >=), in modulo, then one
@@ -213,6 +214,6 @@ async def ceiling_slice_compares(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_ranges(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_ranges(config):
+    run_feature(__name__, *config)

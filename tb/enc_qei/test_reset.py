@@ -182,6 +182,6 @@ async def irq_low_in_reset(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_reset(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_reset(config):
+    run_feature(__name__, *config)

@@ -1,7 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei snapshots: SNAP_COUNT, SNAP_TIME, SNAP_EDGE_TIME, SNAP_DELTA and SNAP_EDGE_DELTA by
 bus command, snap_in and the unit timer (SNAP_PERIOD): coherence within one clock, deltas across
-wraps and reversals, held values, wide values.
+wraps and reversals, held values, wide values. A lean build has no unit timer of its own (the
+global one is there); with the shared engine, whose values are not in per-clock registers,
+snapshot_values_exact checks every snapshot against the motion played clock by clock instead of
+against the core's registers.
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -17,17 +20,19 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, signed
-from enctools.qei.env import CONFIG_IDS, CONFIGS, ClockTrace, begin, read_snapshot, run_feature
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, begin, engine_build, lacks,
+                              read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations
+from enctools.qei.stimulus import ClockWalk, durations
 from enctools.regmap import event_bits, pack
 from enctools.tb import cocotb_test
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("PERIOD") or engine_build())
 async def snapshot_coherence(dut):
     """Snapshots by bus command, snap_in and the unit timer while the shaft turns: SNAP_COUNT,
-    SNAP_TIME, SNAP_EDGE_TIME and SNAP_DELTA all belong to one clock."""
+    SNAP_TIME, SNAP_EDGE_TIME and SNAP_DELTA all belong to one clock (the core's and the timing
+    unit's registers in that clock)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -89,6 +94,71 @@ async def snapshot_coherence(dut):
 
 
 @cocotb_test()
+async def snapshot_values_exact(dut):
+    """Snapshots by SNAP_CTRL.CMD, by snap_in (SNAP_CTRL.IN_EN) and by GSNAP_CTRL.CMD while the
+    shaft moves clock by clock (FILTER_LEN 1, states of 1 to 6 clocks, reversals): each one's
+    SNAP_COUNT, SNAP_EDGE_TIME, SNAP_DELTA and SNAP_EDGE_DELTA are those of the clock its
+    SNAP_TIME names (enctools.qei.stimulus.Timeline: the same pipeline on every build), SNAP_TIME
+    lies between the request and the read, and SNAP_READY is set. EDGE any, then A rising."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=1000, filter_len=1)
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    walker = ClockWalk(dut, [model], rng, positions=[env.pos], shortest=1, longest=6)
+    line = walker.lines[0]
+    task = cocotb.start_soon(walker.run(12000))
+    seen = {}
+    for edge in ("any", "a_rising"):
+        ctrl = pack("SNAP_CTRL", IN_EN=1, EDGE=edge)
+        await bus.wr("SNAP_CTRL", ctrl)
+        await env.applied()
+        switched, prev = walker.now(), None
+        for i in range(14):
+            await ClockCycles(dut.clk, rng.randint(1, 60))
+            how = rng.choice(("cmd", "in", "gsnap"))
+            t0 = walker.now()
+            if how == "cmd":
+                await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
+            elif how == "gsnap":
+                await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+            else:
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 1
+                await FallingEdge(dut.clk)
+                dut.snap_in.value = 0
+            await env.settle(8)
+            snap = await read_snapshot(bus)
+            t = walker.unwrap(snap["time"])
+            what = f"EDGE {edge}, snapshot {i} by {how} at timebase {snap['time']:#x}"
+            assert t0 <= t <= walker.now(), f"{what}: requested at {t0 & ts_mask:#x}"
+            mark = line.at(t)
+            count = (snap["count_hi"] << 32 | snap["count"]) & model.max
+            assert count == mark.count, f"{what}: SNAP_COUNT {count:#x}, count then {mark.count:#x}"
+            e = line.edge(t, edge == "a_rising")
+            if e is not None and e.t > switched:
+                assert snap["edge_time"] == (e.t + line.EDGE_PIPE) & ts_mask, \
+                    f"{what}: SNAP_EDGE_TIME {snap['edge_time']:#x}, last edge's pins set at " \
+                    f"{e.t & ts_mask:#x}"
+            if prev is not None:
+                delta = signed(snap["delta"])
+                assert delta == mark.motion - prev[0].motion, \
+                    f"{what}: SNAP_DELTA {delta}, motion {mark.motion - prev[0].motion}"
+                if e is not None and prev[1] is not None and prev[1].t > switched:
+                    edge_delta = signed(snap["edge_delta"])
+                    assert edge_delta == e.motion - prev[1].motion, \
+                        f"{what}: SNAP_EDGE_DELTA {edge_delta}, motion {e.motion - prev[1].motion}"
+            ev = await bus.events()
+            assert "SNAP_READY" in ev, f"{what}: no SNAP_READY ({sorted(ev)})"
+            await env.applied()
+            prev = (mark, e)
+            seen[how] = seen.get(how, 0) + 1
+    task.cancel()
+    await bus.wr("SNAP_CTRL", 0)
+    dut._log.info("snapshots checked: %s", seen)
+
+
+@cocotb_test()
 async def snapshot_deltas_across_wraps(dut):
     """SNAP_DELTA counts the motion (every step of the function) across modulo wraps and limit
     stops; SNAP_EDGE_DELTA is the position change between the last selected edges (any edge, and
@@ -133,7 +203,7 @@ async def snapshot_deltas_across_wraps(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("PERIOD"))
 async def unit_timer_period(dut):
     """SNAP_PERIOD = P: the unit timer snaps every P ticks (0 and 1: every tick), at PRESCALE 0
     and 1: SNAP_TIME values read 2.5 periods apart differ by a multiple of P, and SNAP_TIME is never
@@ -147,12 +217,13 @@ async def unit_timer_period(dut):
         await bus.wr("TB_PRESCALE", pre)
         await bus.wr("SNAP_PERIOD", p)
         await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        await env.applied()
         times = []
         for wait in (step + 5, 2 * step + step // 2 + 7):
-            await Timer(wait * (pre + 1) * PERIOD_PS, unit="ps")
+            await Timer((wait * (pre + 1) + env.lag) * PERIOD_PS, unit="ps")
             t = await bus.rd("SNAP_TIME")
             tb = await bus.rd("TIMEBASE")
-            assert (tb - t) & ts_mask <= step + 40, \
+            assert (tb - t) & ts_mask <= step + 40 + env.lag, \
                 f"SNAP_PERIOD {p} PRESCALE {pre}: SNAP_TIME {t} a period behind TIMEBASE {tb}"
             times.append(t)
         d = (times[1] - times[0]) & ts_mask
@@ -195,11 +266,13 @@ async def snapshot_wide_values(dut):
             f"TIMEBASE {before:#x}, SNAP_EDGE_TIME {t_edge:#x}, SNAP_TIME {t_snap:#x}, TIMEBASE {after:#x}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("PERIOD"))
 async def unit_timer_prescaled(dut):
     """The unit timer at PRESCALE 2 .. 5 (ticks 3 .. 6 clocks apart: clocks without a tick between
     the ticks): SNAP_PERIOD = P gives a SNAP_READY exactly P x (PRESCALE + 1) clocks after the
-    previous one, and SNAP_TIME values exactly P ticks apart."""
+    previous one, and SNAP_TIME values exactly P ticks apart. (The shared engine shows a snapshot
+    up to its latency late: SNAP_TIME read until it changes, each new value exactly P ticks after
+    the one before.)"""
     env, rng = await begin(dut)
     bus = env.bus
     ts_mask = (1 << int(dut.TS_W.value)) - 1
@@ -209,7 +282,17 @@ async def unit_timer_prescaled(dut):
         await bus.wr("SNAP_PERIOD", p)
         await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
         seen = []
-        for k in range(4):
+        if env.engine:
+            last = await bus.rd("SNAP_TIME")
+            for _ in range(4 * p * (pre + 1)):
+                if len(seen) == 4:
+                    break
+                t = await bus.rd("SNAP_TIME")
+                if t != last:
+                    seen.append((None, t))
+                last = t
+            assert len(seen) == 4, f"PRESCALE {pre} SNAP_PERIOD {p}: {len(seen)} snapshots"
+        for k in range(4 if not env.engine else 0):
             await bus.events()  # clear SNAP_READY; the next one raises irq
             n = 0
             while dut.irq.value == 0:
@@ -220,7 +303,7 @@ async def unit_timer_prescaled(dut):
             t = await bus.rd("SNAP_TIME")
             seen.append((at, t))
         for (c0, t0), (c1, t1) in zip(seen[1:], seen[2:]):  # (the first one: timer phase unknown)
-            assert c1 - c0 == p * (pre + 1), \
+            assert env.engine or c1 - c0 == p * (pre + 1), \
                 f"PRESCALE {pre} SNAP_PERIOD {p}: snapshots {c1 - c0} clocks apart, not {p * (pre + 1)}"
             assert (t1 - t0) & ts_mask == p, \
                 f"PRESCALE {pre} SNAP_PERIOD {p}: SNAP_TIME {t0:#x} then {t1:#x}, not {p} ticks apart"
@@ -349,7 +432,7 @@ async def global_snapshot_one_channel(dut):
     """The global snapshot of a one-channel build: by GSNAP_CTRL.CMD (ten of them, at timebase
     values 173 clocks and a bus transfer apart), by a rising snap_in with GSNAP_CTRL.IN_EN (none
     without it; GSNAP_TIME between the TIMEBASE values read before and after) and by the global
-    unit timer (GSNAP_PERIOD 0x155, then 0x0AA: consecutive GSNAP_TIMEs exactly that far apart). Each one
+    unit timer (GSNAP_PERIOD 0x155, then 0x2AA: consecutive GSNAP_TIMEs exactly that far apart). Each one
     latches the channel's snapshot in its own clock (SNAP_TIME = GSNAP_TIME) and raises
     SNAP_READY."""
     env, rng = await begin(dut)
@@ -396,7 +479,7 @@ async def global_snapshot_one_channel(dut):
             f"snap_in snapshot {i}: GSNAP_TIME {gtime:#x} outside {before:#x}..{after:#x}"
     await bus.wr("GSNAP_CTRL", 0)
 
-    for period in (0x155, 0x0AA):  # every bit of 0 .. 8 set in one of the two, clear in the other
+    for period in (0x155, 0x2AA):  # every bit of 0 .. 9 set in one of the two, clear in the other
         await bus.wr("GSNAP_PERIOD", period)
         await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
         times = []
@@ -417,7 +500,7 @@ async def global_snapshot_one_channel(dut):
 
 @cocotb_test()
 async def unit_timer_high_bits(dut):
-    """SNAP_PERIOD and GSNAP_PERIOD with a high bit set (each of bits 10 .. TS_W - 1, with 3 ticks
+    """SNAP_PERIOD and GSNAP_PERIOD (a lean build: GSNAP_PERIOD) with a high bit set (each of bits 10 .. TS_W - 1, with 3 ticks
     more): no snapshot within 600 clocks of setting PERIOD_EN (a period bit lost on its way to a
     timer would make it fire after a few ticks). And with PERIOD_EN = 0 and the period 0x7FF
     (bits 0 .. 10 set), no snapshot in 2,100 clocks (PERIOD_EN must not depend on the period)."""
@@ -425,7 +508,9 @@ async def unit_timer_high_bits(dut):
     bus = env.bus
     ready = event_bits("SNAP_READY")
     ts_w = int(dut.TS_W.value)
-    for reg, ctrl_reg in (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL")):
+    timers = (("GSNAP_PERIOD", "GSNAP_CTRL"),) if lacks("PERIOD") else \
+        (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL"))
+    for reg, ctrl_reg in timers:
         await bus.wr(reg, 0x7FF)
         await bus.events()
         await bus.wr(ctrl_reg, 0)
@@ -434,7 +519,7 @@ async def unit_timer_high_bits(dut):
         await bus.wr(reg, 0)
     for bit in range(ts_w - 1, 9, -1):
         period = 1 << bit | 3
-        for reg, ctrl_reg in (("SNAP_PERIOD", "SNAP_CTRL"), ("GSNAP_PERIOD", "GSNAP_CTRL")):
+        for reg, ctrl_reg in timers:
             await bus.wr(reg, period)
             await bus.events()
             await bus.wr(ctrl_reg, pack(ctrl_reg, PERIOD_EN=1))
@@ -447,6 +532,6 @@ async def unit_timer_high_bits(dut):
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,count_w,ts_w", CONFIGS, ids=CONFIG_IDS)
-def test_snapshots(top, count_w, ts_w):
-    run_feature(__name__, top, count_w, ts_w)
+@pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
+def test_snapshots(config):
+    run_feature(__name__, *config)

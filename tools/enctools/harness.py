@@ -135,9 +135,9 @@ def spec(toplevel: str, test_module: str, name: str, parameters: dict | None = N
          tb_sources: tuple[str, ...] = (), extra_sources: tuple[Path, ...] = (),
          testcase: str | None = None, extra_env: dict | None = None, quiet: bool = False,
          run_tag: str = "", waves: bool | None = None, wave_depth: int = 0,
-         vcd: Path | None = None, seed: str | None = None) -> RunSpec:
+         vcd: Path | None = None, seed: str | None = None, sim: str | None = None) -> RunSpec:
     """The RunSpec of a run with the usual sources (see :func:`run`), before the hooks."""
-    sim = sim_name()
+    sim = sim or sim_name()
     s = RunSpec(toplevel=toplevel, test_module=test_module, name=name, sim=sim,
                 parameters=dict(parameters or {}),
                 sources=rtl_sources() + [TB_HDL / f for f in tb_sources] + [Path(p) for p in extra_sources],
@@ -195,16 +195,16 @@ def run(toplevel: str, test_module: str, name: str, parameters: dict | None = No
         tb_sources: tuple[str, ...] = (), extra_sources: tuple[Path, ...] = (),
         testcase: str | None = None, extra_env: dict | None = None, quiet: bool = False,
         run_tag: str = "", waves: bool | None = None, wave_depth: int = 0,
-        vcd: Path | None = None, seed: str | None = None) -> Outcome:
+        vcd: Path | None = None, seed: str | None = None, sim: str | None = None) -> Outcome:
     """Build ``toplevel`` (or reuse its build) and run the cocotb tests of ``test_module`` (a
     module name the simulator's Python can import: a test file's ``__name__`` under pytest, or a
     module of enctools). ``tb_sources`` are file names in tb/hdl/, ``extra_sources`` any other HDL
     files. With ``quiet`` the simulator's output goes to build.log / test.log. ``waves`` (default:
     ENC_WAVES), ``wave_depth`` and ``vcd``: see the module docstring; ``seed``: the regression seed
-    (default: SEED). Raises when a test failed (unless a hook judges the run), else returns the
-    Outcome."""
+    (default: SEED); ``sim``: the simulator, whatever SIM says (a run too slow on the other).
+    Raises when a test failed (unless a hook judges the run), else returns the Outcome."""
     s = spec(toplevel, test_module, name, parameters, tb_sources, extra_sources, testcase,
-             extra_env, quiet, run_tag, waves, wave_depth, vcd, seed)
+             extra_env, quiet, run_tag, waves, wave_depth, vcd, seed, sim)
     for h in _hooks:
         h.configure(s)
     if s.waves and s.sim == "verilator" and s.wave_depth:

@@ -38,6 +38,14 @@ def qei(file: str, corners: tuple[str, ...], *first: str, rate: bool = False,
 
 
 RATE = "tb/count_rate/test_count_rate.py"
+ENGINE_TESTS = ("tb/enc_qei/test_engine.py", CHANNELS)
+ENGINE_CORNERS = ("tb/enc_qei/test_engine.py::*[enc_qei_wb-ch3-engine]",
+                  "tb/enc_qei/test_channels.py::*[enc_qei_axil-ch3-full-engine]")
+
+
+def engine(file: str) -> Module:
+    return Module(file, ENGINE_TESTS, ENGINE_CORNERS, suite=QEI_SUITE,
+                  priority=("latency", "random_motion", "write_effect", "independent_walks", "global_snapshot"))
 
 MODULES: dict[str, Module] = {
     "ls168": Module("rtl/ls168.v", ("tb/ls168/test_ls168.py",)),
@@ -87,4 +95,16 @@ MODULES: dict[str, Module] = {
                       "byte_enables", "isolation", "channel_map", channels=True),
     "enc_qei_axil": qei("rtl/enc_qei_axil.v", (AX1,), "concurrent_reads_and_writes",
                         "byte_enables"),
+    # the shared engine (ENGINE = 1): its Icarus builds, three lean channels on Wishbone (the
+    # engine's own tests against a per-channel build, and test_channels' traffic) and three full
+    # ones on AXI4-Lite (test_channels); its feature-file and 16-channel builds run on Verilator.
+    # enc_qei_ram is not mutated: every engine build instantiates it at two widths (one mutant
+    # design cannot serve both), and it is a plain two-port memory the engine's tests read through
+    "enc_qei_engine": engine("rtl/enc_qei_engine.v"),
+    "enc_qei_lane": engine("rtl/enc_qei_lane.v"),
+    # shared by both architectures: the per-channel build's feature tests first
+    "enc_qei_decode": qei("rtl/enc_qei_decode.v", (WB1,), "func_walks", "swap_and_invert",
+                          "steps_in_consecutive_clocks", rate=True),
+    "enc_filter_rt": qei("rtl/enc_filter_rt.v", (WB1,), "filter_lengths", "filter_len_clamp",
+                         "reset_in_each_state", rate=True),
 }

@@ -151,3 +151,36 @@ class QeiBus:
             await self.wr("EVENTS", word)
         return event_names(word)
 
+
+
+class WbRaw:
+    """Wishbone B4 classic driven on enc_qei_wb's raw signals, for measurements to the clock: each
+    access sets its request at a falling edge and returns (stamp, data, err), where stamp is the
+    timebase (dut.u_qei.timebase: one tick a clock at TB_PRESCALE 0) in the clock before the
+    request is sampled; it ends at the falling edge after the acknowledge, where the next one can
+    begin. Do not use it while a QeiBus transaction is under way."""
+
+    def __init__(self, dut):
+        self.dut = dut
+        self.tb = dut.u_qei.timebase
+
+    async def access(self, adr: int, data: int | None = None, sel: int = 0xF) -> tuple[int, int, bool]:
+        from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+
+        dut = self.dut
+        await FallingEdge(dut.clk)
+        dut.wb_adr_i.value = adr
+        dut.wb_we_i.value = int(data is not None)
+        dut.wb_dat_i.value = (data or 0) & 0xFFFFFFFF
+        dut.wb_sel_i.value = sel
+        dut.wb_cyc_i.value = dut.wb_stb_i.value = 1
+        stamp = int(self.tb.value)
+        while True:
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            if dut.wb_ack_o.value or dut.wb_err_o.value:
+                break
+        value, err = int(dut.wb_dat_o.value), bool(dut.wb_err_o.value)
+        await FallingEdge(dut.clk)
+        dut.wb_cyc_i.value = dut.wb_stb_i.value = dut.wb_we_i.value = 0
+        return stamp, value, err

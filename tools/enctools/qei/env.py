@@ -2,8 +2,10 @@
 """The enc_qei test environment shared by the feature files of tb/enc_qei/.
 
 - ``CONFIGS`` / ``CONFIG_IDS``: the builds every feature file runs on (enc_qei_wb at COUNT_W 32 /
-  TS_W 32, enc_qei_axil at COUNT_W 64 / TS_W 16), and ``run_feature()``, the pytest side of a
-  feature file: one build name per configuration, so that every feature file shares its build.
+  TS_W 32, enc_qei_axil at COUNT_W 64 / TS_W 16, each with a datapath per channel and with the
+  shared engine), and ``run_feature()``, the pytest side of a feature file: one build name per
+  configuration, so that every feature file shares its build. ``lacks()`` tells a test file
+  which units (enctools.regmap.units) the build it runs on leaves out, to skip their tests.
 - ``Env`` (``begin(dut)`` makes one): the bus, the quadrature driver and the stimulus position;
   ``setup`` programs the peripheral and the model alike, ``play`` drives a waveform into both,
   ``check`` compares COUNT and EVENTS with the model.
@@ -23,34 +25,92 @@ from hedsmodel import QUAD
 from enctools.qei.bus import PERIOD_PS, QeiBus
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import FILTER
-from enctools.regmap import enum, pack
+from enctools.regmap import enum, pack, units
 from enctools.tb import start
 
-PROFILE_LEAN = enum("CAPS", "PROFILE")["lean"]
+PROFILES = enum("CAPS", "PROFILE")  # name -> CAPS.PROFILE / the PROFILE parameter
+PROFILE_LEAN = PROFILES["lean"]
+
+
+# The shared engine's bounds (ENGINE = 1), as the RDL text of CAPS.ENGINE's value shared gives them
+# (tb/enc_qei/test_engine.py holds the RTL to them and checks that the text says these numbers):
+# clocks after the per-channel build shows a value, or after a write's request, with P below.
+ENGINE_VISIT = 24       # clocks the engine spends on one channel
+ENGINE_SHOW = 44        # a read requested P + 44 clocks after the per-channel build shows a value shows it
+ENGINE_SHOW_COUNT = 24  # ... COUNT_LO / COUNT_HI: P + 24
+ENGINE_IRQ = 44         # irq and IRQ_SUMMARY rise and fall at most P + 44 later
+ENGINE_ACT = 18         # a write of a register the counting uses acts at most P + 18 after its request
+ENGINE_STATE_ACT = 26   # a write of EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN or COUNT_HI: P + 26
+ENGINE_WAIT = 40        # a read or a second write of a channel waits at most P + 40 for a write
+ENGINE_ANSWER = 4       # otherwise a channel register access is answered 4 clocks after its request
+PER_CHANNEL_ANSWER = 2  # ... 2 on a per-channel build
+
+
+def engine_period(channels: int) -> int:
+    """P: the clocks between two reads of a channel by the shared engine (one visit per channel,
+    at least two channels: one idle with one channel)."""
+    return ENGINE_VISIT * max(channels, 2)
 
 
 def engine_lag(channels: int) -> int:
-    """The most clocks the shared engine (ENGINE = 1) takes to show a step in COUNT, an event in
-    EVENTS or a snapshot in SNAP_*: one visit round (24 clocks a channel, at least two channels)
-    plus the visit that computes it and the one that writes it (rtl/enc_qei_engine.v)."""
-    return 24 * max(channels, 2) + 52
+    """The clocks a test waits for the shared engine to show what happened before (a step in
+    COUNT, an event in EVENTS, a snapshot in SNAP_*, a write acting): more than every bound
+    above."""
+    return engine_period(channels) + 52
+
 
 # ---- configurations and the pytest side -----------------------------------------------------------
-CONFIGS = (("enc_qei_wb", 32, 32), ("enc_qei_axil", 64, 16))  # (top, COUNT_W, TS_W)
-CONFIG_IDS = tuple(f"{top}-c{count_w}-t{ts_w}" for top, count_w, ts_w in CONFIGS)
+# (top, COUNT_W, TS_W, PROFILE, ENGINE): one channel each; the shared engine's on Verilator whatever
+# SIM says (Icarus takes about 5 times longer; tb/enc_qei/test_engine.py and test_channels.py run
+# the engine on Icarus too)
+CONFIGS = (("enc_qei_wb", 32, 32, "full", 0), ("enc_qei_axil", 64, 16, "full", 0),
+           ("enc_qei_wb", 32, 32, "full", 1), ("enc_qei_axil", 64, 16, "full", 1),
+           ("enc_qei_wb", 32, 32, "lean", 1))
 
 
-def build_name(top: str, count_w: int, ts_w: int) -> str:
+def config_id(top: str, count_w: int, ts_w: int, profile: str = "full", engine: int = 0) -> str:
+    return f"{top}-c{count_w}-t{ts_w}" + ("" if profile == "full" else f"-{profile}") + \
+        ("-engine" if engine else "")
+
+
+CONFIG_IDS = tuple(config_id(*c) for c in CONFIGS)
+
+
+def build_name(top: str, count_w: int, ts_w: int, profile: str = "full", engine: int = 0) -> str:
     """The one build name of a configuration: every feature file runs on the same build."""
-    return f"{top}_c{count_w}_t{ts_w}"
+    return f"{top}_c{count_w}_t{ts_w}" + ("" if profile == "full" else f"_{profile}") + \
+        (f"_e{engine}" if engine else "")
 
 
-def run_feature(module: str, top: str, count_w: int, ts_w: int):
+def run_feature(module: str, top: str, count_w: int, ts_w: int, profile: str = "full",
+                engine: int = 0):
     """Run the cocotb tests of feature file ``module`` (its ``__name__``) on one configuration."""
     from enctools.harness import run  # (here: the simulator's Python, importing env, needs no harness)
 
-    return run(top, module, name=build_name(top, count_w, ts_w),
-               parameters={"COUNT_W": count_w, "TS_W": ts_w})
+    return run(top, module, name=build_name(top, count_w, ts_w, profile, engine),
+               parameters={"COUNT_W": count_w, "TS_W": ts_w, "PROFILE": PROFILES[profile],
+                           "ENGINE": engine}, sim="verilator" if engine else None)
+
+
+def engine_build() -> bool:
+    """True when the build being simulated has the shared engine (ENGINE = 1), whose channel
+    values are in its memory, not in per-channel registers a test could watch. False outside a
+    simulation."""
+    top = getattr(cocotb, "top", None)
+    return top is not None and int(top.ENGINE.value) != 0
+
+
+def lacks(*names: str) -> bool:
+    """True when the build being simulated leaves out one of the units ``names`` (the RDL's
+    feature names, enctools.regmap.units: RANGE = range modes, CEILING and compare; PROBE;
+    PERIOD = period capture, stall and the channel's own unit timer), for a test's skip option:
+    ``@cocotb_test(skip=lacks("RANGE"))``. False outside a simulation (pytest collecting)."""
+    top = getattr(cocotb, "top", None)
+    if top is None:
+        return False
+    profile = int(top.PROFILE.value)
+    have = units(pack("CAPS", PROFILE=profile, TIMING=int(profile != PROFILES["counting"])))
+    return not set(names) <= have
 
 
 # ---- the environment -------------------------------------------------------------------------------
@@ -75,6 +135,14 @@ class Env:
         STATUS show what happened before)."""
         await ClockCycles(self.dut.clk, clocks + self.lag)
 
+    async def applied(self):
+        """Wait until the bus writes before have taken effect: the shared engine applies a write
+        at the channel's next visit, within `lag` clocks (a W1C of EVENTS or a write clearing
+        QERR_COUNT / GLITCH_COUNT clears what the channel raised up to then); the per-channel
+        build at once."""
+        if self.lag:
+            await ClockCycles(self.dut.clk, self.lag)
+
     async def setup(self, model: QeiModel, func="x4", rng_mode="free", filter_len=FILTER,
                     count=0, ceiling=None, compare=None, en=1):
         bus = self.bus
@@ -97,6 +165,7 @@ class Env:
         await bus.events()
         await bus.wr("QERR_COUNT", 0)
         await bus.wr("GLITCH_COUNT", 0)
+        await self.applied()
         model.take_events()
         model.qerrs = 0
 
@@ -144,8 +213,10 @@ async def begin(dut):
 
 def channel(dut, k: int = 0):
     """Channel k's enc_qei_channel instance inside the bus adapter (its core is ``.u_core``, its
-    timing unit ``.g_timing.u_timing``)."""
-    return dut.u_qei.g_ch[k].u_chan
+    timing unit ``.g_timing.u_timing``) of a build with a datapath per channel (ENGINE = 0; in
+    enc_qei's generate block g_per_channel, or without it where a tool rewrote the design)."""
+    qei = dut.u_qei
+    return (qei.g_per_channel if hasattr(qei, "g_per_channel") else qei).g_ch[k].u_chan
 
 
 # ---- clock trace and snapshots ---------------------------------------------------------------------

@@ -5,6 +5,9 @@ files use (wide bit patterns, CEILINGs, the burst of steps in consecutive clocks
 
 from __future__ import annotations
 
+import bisect
+from dataclasses import dataclass
+
 from cocotb.triggers import ClockCycles, FallingEdge
 from hedsmodel import walk
 
@@ -120,3 +123,119 @@ def ceilings(count_w, zero=True):
 
 def near(values, lo, hi):
     return sorted({v for v in values if lo <= v <= hi})
+
+
+# ---- clock-exact walks on every channel, with what a snapshot of any clock holds ------------------------
+@dataclass
+class Mark:
+    """A channel's state after one sampled change: ``t`` the timebase (unwrapped, TB_PRESCALE 0)
+    at the falling edge that set the pins, the model's count and motion (QeiModel.delta, every
+    step while EN) after it, whether it was a step (any edge) and an A-rising edge."""
+
+    t: int
+    count: int
+    motion: int
+    step: bool
+    a_rise: bool
+
+
+class Timeline:
+    """One channel's marks, and the snapshot registers of any clock. SNAP_PIPE: a change whose pins
+    were set at timebase t is in a snapshot whose SNAP_TIME is t + SNAP_PIPE or later (FILTER_LEN
+    1); EDGE_PIPE: an edge's SNAP_EDGE_TIME is t + EDGE_PIPE. The same on every build (the shared
+    engine shows a snapshot later, never other values)."""
+
+    SNAP_PIPE = 6
+    EDGE_PIPE = 6
+
+    def __init__(self, count: int):
+        self.marks = [Mark(-(1 << 62), count, 0, False, False)]
+        self.times = [self.marks[0].t]
+
+    def add(self, mark: Mark) -> None:
+        self.marks.append(mark)
+        self.times.append(mark.t)
+
+    def _last(self, t: int) -> int:
+        return bisect.bisect_right(self.times, t - self.SNAP_PIPE) - 1
+
+    def at(self, t: int) -> Mark:
+        """The last mark a snapshot at (unwrapped) timebase t holds."""
+        return self.marks[self._last(t)]
+
+    def edge(self, t: int, a_rising: bool) -> Mark | None:
+        """The last selected edge (SNAP_CTRL.EDGE) a snapshot at timebase t holds."""
+        for i in range(self._last(t), 0, -1):
+            m = self.marks[i]
+            if m.a_rise if a_rising else m.step:
+                return m
+        return None
+
+
+class ClockWalk:
+    """Random walks on channels 0 .. len(models) - 1 of a build at once, clock by clock (FILTER_LEN
+    1: a level set at a falling edge is sampled at the next rising edge): each channel holds a
+    state for a random number of clocks in [shortest, longest], steps back with probability
+    ``p_reverse``, and its Z level is zfuns[k](position) (None: Z low). Every change is fed to the
+    channel's model in order and marked on its Timeline with the timebase of its clock
+    (TB_PRESCALE 0), so that a snapshot can be checked against the clock its SNAP_TIME names.
+    Walk k drives bit bits[k] of the vectors a_in, b_in, z_in (default: bit k)."""
+
+    def __init__(self, dut, models, rng, positions=None, shortest=1, longest=4, p_reverse=0.2,
+                 zfuns=None, bits=None):
+        self.dut, self.models, self.rng = dut, models, rng
+        n = len(models)
+        self.bits = list(bits if bits is not None else range(n))
+        self.pos = list(positions or [0] * n)
+        self.z = [0] * n
+        self.shortest, self.longest, self.p_reverse = shortest, longest, p_reverse
+        self.zfuns = zfuns or [None] * n
+        self.dirs = [1] * n
+        self.lines = [Timeline(m.count) for m in models]
+        self.ts_mask = (1 << int(dut.TS_W.value)) - 1
+        self.tb = dut.u_qei.timebase
+        self.last_tb = int(self.tb.value)
+        self.t = self.last_tb  # the timebase unwrapped
+
+    def now(self) -> int:
+        """The timebase now, unwrapped (it must be read at least once per wrap of the timebase:
+        run() reads it every clock)."""
+        tb = int(self.tb.value)
+        self.t += (tb - self.last_tb) & self.ts_mask
+        self.last_tb = tb
+        return self.t
+
+    def unwrap(self, tb: int) -> int:
+        """A timebase value read from a register (less than one wrap of the timebase ago)."""
+        return self.now() - ((self.last_tb - tb) & self.ts_mask)
+
+    async def run(self, clocks: int) -> None:
+        dut, rng, n = self.dut, self.rng, len(self.models)
+        hold = [rng.randint(self.shortest, self.longest) for _ in range(n)]
+        a = int(dut.a_in.value)
+        b = int(dut.b_in.value)
+        z = int(dut.z_in.value)
+        for _ in range(clocks):
+            await FallingEdge(dut.clk)
+            self.now()
+            for k in range(n):
+                hold[k] -= 1
+                if hold[k] > 0:
+                    continue
+                hold[k] = rng.randint(self.shortest, self.longest)
+                if rng.random() < self.p_reverse:
+                    self.dirs[k] = -self.dirs[k]
+                old = QUAD[self.pos[k] % 4]
+                self.pos[k] += self.dirs[k]
+                new = QUAD[self.pos[k] % 4]
+                zk = self.zfuns[k](self.pos[k]) if self.zfuns[k] else 0
+                bit = self.bits[k]
+                a = a & ~(1 << bit) | new[0] << bit
+                b = b & ~(1 << bit) | new[1] << bit
+                z = z & ~(1 << bit) | zk << bit
+                self.z[k] = zk
+                model = self.models[k]
+                model.sample(new, zk)
+                self.lines[k].add(Mark(self.t, model.count, model.delta, True,
+                                       (old[0], new[0]) == (0, 1)))
+            dut.a_in.value, dut.b_in.value, dut.z_in.value = a, b, z
