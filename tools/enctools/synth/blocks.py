@@ -137,6 +137,7 @@ class Result:
     failures: list = field(default_factory=list)  # reasons this run must fail
     seconds: float = 0.0
     fits: bool = True  # False: more than the part holds, not placed
+    reused: bool = False  # the tool run's inputs were unchanged: its earlier outputs were read
 
 
 def lut_need(res: Result) -> int:

@@ -25,6 +25,10 @@ intercept is the bus, the register decode, the global units (and the engine), th
 more channel costs. Printed and written to doc/results/synth_channels.md. A build that is also a
 row of the first table is synthesised once.
 
+A Yosys or nextpnr run whose inputs (script or command line, the files it reads, the YoWASP
+package's version) are those of its earlier run in build/synth/ is not run again: its outputs are
+read (the progress line says so; `make clean` forgets them). An interrupted run resumes that way.
+
 The run fails (exit 1) on
   - any latch left after `proc` (`select -assert-none t:$dlatch ...`),
   - any Yosys warning not waived in scripts/synth_waivers.txt,
@@ -38,6 +42,9 @@ Options:
                      file is not rewritten)
   --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
                      shared engine's rows); as --only, no table file is rewritten
+  --update           with --only or --param: the rows built replace theirs in the table file, the
+                     other rows are kept from it as they are (rows of a table with other columns
+                     keep the columns they have, "-" for the rest)
   --jobs N           parallel tool runs (default 2)
   --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels,
                      per channel and shared engine: 2) or left out (8 full on the ECP5, the other
@@ -65,7 +72,7 @@ from ..paths import TOP
 from .blocks import BLOCKS, BUILD, CHANNELS_MD, RESULTS_MD, SEED, WAIVERS, Block, Result
 from .build import Waiver, load_waivers, merge_seeds, seed_run, synthesize
 from .channels import SWEEP_CHANNELS, channel_table, channels_markdown, sweep_blocks
-from .report import changes, efifo_table, markdown, previous_rows, table
+from .report import changes, efifo_table, kept_rows, markdown, previous_rows, table
 
 
 def parse_channels(text: str) -> list[int]:
@@ -97,6 +104,10 @@ def parse_param(text: str) -> tuple[str, int]:
 def weight(b: Block) -> int:
     """A rough size, for the order of the jobs: the channels, the ECP5's slower place and route."""
     return b.params.get("CHANNELS", 1) * (3 if b.device == "ecp5" else 1)
+
+
+def took(reused: bool, seconds: float) -> str:
+    return "inputs unchanged: earlier run reused" if reused else f"{seconds:.0f} s"
 
 
 def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers: int) -> dict[str, Result]:
@@ -146,12 +157,13 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
                 put(1, "pnr", b, s)
             outstanding += b.seeds
             print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  synthesised "
-                  f"({seconds:.0f} s), placing with {b.seeds} seed{'s' if b.seeds > 1 else ''}", flush=True)
+                  f"({took(r.reused, seconds)}), placing with {b.seeds} seed{'s' if b.seeds > 1 else ''}",
+                  flush=True)
             continue
         if kind == "pnr":
             runs[b.key].append(out)
             fm = f"{out.fmax:.1f} MHz" if out.fmax is not None else out.note or "no clock"
-            print(f"{head} seed {seed}: {fm} ({seconds:.0f} s)", flush=True)
+            print(f"{head} seed {seed}: {fm} ({took(out.reused, seconds)})", flush=True)
             if len(runs[b.key]) < b.seeds:
                 continue
             merge_seeds(r, runs[b.key])
@@ -159,7 +171,8 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
             fm = (f"{r.fmax:.1f} MHz" if r.fmax is not None else "synthesis only" if not b.pnr else
                   "does not fit" if not r.fits else "no clock")
             print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  {fm:>14s}"
-                  f"  ({r.seconds:.0f} s){'  FAIL' if r.failures else ''}", flush=True)
+                  f"  ({r.seconds:.0f} s{', synthesis reused' if r.reused else ''})"
+                  f"{'  FAIL' if r.failures else ''}", flush=True)
         else:
             print(f"{head} {r.note}", flush=True)
     for _ in threads:
@@ -176,6 +189,8 @@ def main() -> int:
                     help="synthesize only these modules' rows (no channel table)")
     ap.add_argument("--param", nargs="+", metavar="NAME=VALUE", type=parse_param, default=[],
                     help="only the rows with these parameters, e.g. ENGINE=1 (no channel table)")
+    ap.add_argument("--update", action="store_true",
+                    help="with --only or --param: these rows replace theirs in the table file, the others stay")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
     ap.add_argument("--quick", action="store_true",
                     help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
@@ -191,6 +206,8 @@ def main() -> int:
     if picked and args.table in ("both", "channels"):
         ap.error("--only and --param pick rows of the first table; the channel table runs without them "
                  "(--table channels)")
+    if args.update and (not picked or args.quick):
+        ap.error("--update goes with --only or --param (a whole run rewrites the table file), not --quick")
     table_kind = args.table or ("blocks" if picked or args.quick else "both")
     if args.channels and table_kind == "blocks":
         ap.error("--channels sets the channel table, which this run does not make (--table both or channels)")
@@ -232,6 +249,13 @@ def main() -> int:
             RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
             RESULTS_MD.write_text(markdown(ordered))
             print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
+        elif args.update:
+            kept, efifo = kept_rows(RESULTS_MD)
+            rows = [results[b.key] if b.key in results else kept.get((b.name, b.param_text, b.part))
+                    for b in BLOCKS]
+            RESULTS_MD.write_text(markdown([r for r in rows if r is not None], efifo))
+            print(f"\nsynth: {len(ordered)} row(s) of {RESULTS_MD.relative_to(TOP)} replaced, "
+                  f"{sum(1 for r in rows if isinstance(r, dict))} kept from it")
     if sweep:
         print()
         print(channel_table(results, channels, "luts"))
