@@ -21,9 +21,9 @@ row in doc/results/soc_bitstream.md.
   on the extension board's P3A, P3B, P2A and P4B), 16 KiB of ROM holding sw/soc, 32 KiB of SRAM
   (the engine's state memory takes block RAM that 64 KiB would need), at 60 MHz.
 
-``--ts-w``, ``--channels`` and ``--cpu-variant`` change a board's build for a try (its row says
-what was built). A build that does not fit its part is a row too: what it needed, from nextpnr's
-report of the failed placement.
+``--ts-w``, ``--channels``, ``--cpu-variant`` and ``--sram-kib`` change a board's build for a try
+(its row says what was built). A build that does not fit its part is a row too: what it needed,
+from nextpnr's report of the failed placement.
 
 The pins are the boards' (their published pinouts; the Colorlight i5's extension board v1.2);
 no board is at hand here, so the bitstreams are built and measured, not run.
@@ -295,11 +295,20 @@ def _row(board: Board, res: dict) -> str:
 
 
 def _key(line: str) -> tuple | None:
+    """(board, CPU, channels, program, SRAM) of a row; the program by its first word (sw/soc or
+    none), the SRAM as the row states it (None: a row that does not)."""
     cells = [x.strip() for x in line.strip().strip("|").split("|")]
     if len(cells) != len(COLUMNS) or cells[0] not in BOARDS:
         return None
-    # (the program by its first word: sw/soc or none)
-    return tuple(cells[i].split(" (")[0] if i != 9 else cells[i].split()[0] for i in KEY_COLUMNS)
+    sram = re.search(r"(\d+) KiB SRAM", cells[9])
+    return (*(cells[i].split(" (")[0] if i != 9 else cells[i].split()[0] for i in KEY_COLUMNS),
+            sram and sram.group(1))
+
+
+def _replaces(new: tuple, old: tuple) -> bool:
+    """A new row replaces an old one of the same build; an old row that does not state its SRAM,
+    whatever the new row's SRAM."""
+    return new[:-1] == old[:-1] and old[-1] in (None, new[-1])
 
 
 def write_results(board: Board, res: dict) -> None:
@@ -307,7 +316,8 @@ def write_results(board: Board, res: dict) -> None:
             "hand -->", "", "# enc_qei in a LiteX SoC on FPGA boards: size and speed", "",
             "Yosys and nextpnr (YoWASP, seed 1) on the SoCs of `tools/enctools/litex/boards.py` "
             "(doc/litex.md), one row per build (a board's defaults, or a try with other "
-            "`--ts-w`, `--channels` or `--cpu-variant`). Logic: LUT4 cells used of the part's "
+            "`--ts-w`, `--channels`, `--cpu-variant` or `--sram-kib`). Logic: LUT4 cells used of "
+            "the part's "
             "(iCE40 logic cells hold one LUT4 and its flip-flop; ECP5 TRELLIS_COMB); a build that "
             "does not fit shows what nextpnr found it needs before it stopped. Fmax: nextpnr's "
             "estimate for the sys clock after routing; time: the whole build on the project's "
@@ -317,7 +327,7 @@ def write_results(board: Board, res: dict) -> None:
     rows = []
     if RESULT_FILE.exists():
         rows = [line for line in RESULT_FILE.read_text().splitlines()
-                if _key(line) is not None and _key(line) != _key(new)]
+                if _key(line) is not None and not _replaces(_key(new), _key(line))]
     rows.append(new)
     order = list(BOARDS)
     rows.sort(key=lambda line: order.index(_key(line)[0]))  # stable: a board's rows as written
@@ -334,6 +344,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--channels", type=int, metavar="N",
                     help="the first N of the board's channels (its pins) instead of all")
     ap.add_argument("--cpu-variant", metavar="NAME", help="VexRiscv variant instead of the board's")
+    ap.add_argument("--sram-kib", type=int, metavar="N", help="KiB of SRAM instead of the board's")
     args = ap.parse_args(argv)
     board = BOARDS[args.board]
     if args.channels is not None and not 1 <= args.channels <= len(board.encoders):
@@ -344,7 +355,12 @@ def main(argv: list[str] | None = None) -> int:
         from litex.soc.cores.cpu.vexriscv.core import CPU_VARIANTS
         if args.cpu_variant not in CPU_VARIANTS:
             ap.error(f"--cpu-variant {args.cpu_variant}: not one of {', '.join(CPU_VARIANTS)}")
+    if args.sram_kib is not None and (args.sram_kib < 1 or args.sram_kib & (args.sram_kib - 1) or
+                                      (board.sram == "spram" and args.sram_kib not in (64, 128))):
+        ap.error(f"--sram-kib {args.sram_kib}: a power of two"
+                 f"{' (the UP5K SPRAM: 64 or 128)' if board.sram == 'spram' else ''}")
     board = replace(board, ts_w=args.ts_w or board.ts_w,
+                    sram_size=(args.sram_kib or board.sram_size // 1024) * 1024,
                     encoders=board.encoders[:args.channels or len(board.encoders)],
                     cpu_variant=args.cpu_variant or board.cpu_variant)
     res = build(board)
