@@ -45,6 +45,8 @@ Options:
   --update           with --only or --param: the rows built replace theirs in the table file, the
                      other rows are kept from it as they are (rows of a table with other columns
                      keep the columns they have, "-" for the rest)
+  --seeds N          at most N nextpnr seeds per row (seeds 1..N; the seeds column says how many a
+                     row had): a first figure of a long row, whose other seeds a later run adds
   --jobs N           parallel tool runs (default 2)
   --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels,
                      per channel and shared engine: 2) or left out (8 full on the ECP5, the other
@@ -191,6 +193,8 @@ def main() -> int:
                     help="only the rows with these parameters, e.g. ENGINE=1 (no channel table)")
     ap.add_argument("--update", action="store_true",
                     help="with --only or --param: these rows replace theirs in the table file, the others stay")
+    ap.add_argument("--seeds", type=int, metavar="N",
+                    help="at most N nextpnr seeds per row (a row's seeds column says how many it had)")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
     ap.add_argument("--quick", action="store_true",
                     help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
@@ -223,6 +227,10 @@ def main() -> int:
         blocks = [b for b in blocks if all(b.params.get(k) == v for k, v in args.param)]
         if not blocks:
             ap.error("no row has " + ", ".join(f"{k}={v}" for k, v in args.param))
+    if args.seeds is not None:
+        if args.seeds < 1:
+            ap.error(f"--seeds must be at least 1, not {args.seeds}")
+        blocks = [Block(**{**b.__dict__, "seeds": min(b.seeds, args.seeds)}) for b in blocks]
     if args.quick:
         blocks = [Block(**{**b.__dict__, "seeds": 1, "params": {**b.params, **b.quick}})
                   for b in blocks if b.quick is not None]
