@@ -305,12 +305,6 @@ def _key(line: str) -> tuple | None:
             sram and sram.group(1))
 
 
-def _replaces(new: tuple, old: tuple) -> bool:
-    """A new row replaces an old one of the same build; an old row that does not state its SRAM,
-    whatever the new row's SRAM."""
-    return new[:-1] == old[:-1] and old[-1] in (None, new[-1])
-
-
 def write_results(board: Board, res: dict) -> None:
     head = ["<!-- written by scripts/soc_bitstream.py (make soc-bitstream); do not edit by "
             "hand -->", "", "# enc_qei in a LiteX SoC on FPGA boards: size and speed", "",
@@ -327,7 +321,7 @@ def write_results(board: Board, res: dict) -> None:
     rows = []
     if RESULT_FILE.exists():
         rows = [line for line in RESULT_FILE.read_text().splitlines()
-                if _key(line) is not None and not _replaces(_key(new), _key(line))]
+                if _key(line) is not None and _key(line) != _key(new)]
     rows.append(new)
     order = list(BOARDS)
     rows.sort(key=lambda line: order.index(_key(line)[0]))  # stable: a board's rows as written
