@@ -248,7 +248,7 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
         return
     fmaxes = sorted(run.fmax for run in runs if run.fmax is not None)
     if fmaxes:
-        res.fmax = fmaxes[len(fmaxes) // 2]
+        res.fmax = fmaxes[(len(fmaxes) - 1) // 2]  # of an even number of seeds, the lower middle
         # packing does not depend on the seed; the median seed's count all the same
         median = next(run for run in runs if run.fmax == res.fmax)
         res.placed, res.placed_of = median.placed, median.placed_of
@@ -288,7 +288,7 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
     else:
         stamp.unlink(missing_ok=True)
         proc = run_tool(cmd, out, plog)
-        if key:
+        if key and proc.returncode >= 0:  # (not when a signal stopped it)
             stamp.write_text(f"{key} {proc.returncode}\n")
     plog_text = plog.read_text() if plog.exists() else ""
     if proc.returncode != 0:
