@@ -351,8 +351,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"--cpu-variant {args.cpu_variant}: not one of {', '.join(CPU_VARIANTS)}")
     if args.sram_kib is not None and (args.sram_kib < 1 or args.sram_kib & (args.sram_kib - 1) or
                                       (board.sram == "spram" and args.sram_kib not in (64, 128))):
-        ap.error(f"--sram-kib {args.sram_kib}: a power of two"
-                 f"{' (the UP5K SPRAM: 64 or 128)' if board.sram == 'spram' else ''}")
+        ap.error(f"--sram-kib {args.sram_kib}: "
+                 f"{'64 or 128 (the UP5K SPRAM)' if board.sram == 'spram' else 'a power of two'}")
     board = replace(board, ts_w=args.ts_w or board.ts_w,
                     sram_size=(args.sram_kib or board.sram_size // 1024) * 1024,
                     encoders=board.encoders[:args.channels or len(board.encoders)],
