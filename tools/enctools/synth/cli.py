@@ -39,9 +39,9 @@ Goals missed are reported in the table but do not fail the run (they are targets
 Options:
   --bitstream        also run icepack: build/icebreaker/icebreaker_top.bin (`make bitstream`)
   --only NAME ...    just these modules' rows of the first table (no channel table; the table
-                     file is not rewritten)
+                     file is not rewritten, but see --update)
   --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
-                     shared engine's rows); as --only, no table file is rewritten
+                     shared engine's rows); as --only
   --update           with --only or --param: the rows built replace theirs in the table file, the
                      other rows are kept from it as they are (rows of a table with other columns
                      keep the columns they have, "-" for the rest)
