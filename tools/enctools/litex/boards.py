@@ -17,9 +17,10 @@ row in doc/results/soc_bitstream.md.
   of the extension board, no index), 16 KiB of ROM holding sw/soc, 64 KiB of SRAM, at 60 MHz
   from the PLL (the 1 kHz handler needs about 500 cycles per channel with the fixed-point
   estimator, doc/results/soc_sim.md).
-- ``colorlight_i5_engine``: VexRiscv ``full``, 16 full channels that share one engine (A and B
-  on the extension board's P3A, P3B, P2A and P4B), 16 KiB of ROM holding sw/soc, 32 KiB of SRAM
-  (the engine's state memory takes block RAM that 64 KiB would need), at 60 MHz.
+- ``colorlight_i5_engine``: VexRiscv ``lite``, 16 full channels that share one engine (A and B
+  on the extension board's P3A, P3B, P2A and P4B), 16 KiB of ROM holding sw/soc (built with 20
+  snapshot records), 16 KiB of SRAM, at 60 MHz: the engine's state memory takes 32 of the 56
+  DP16KD, and ``full`` or 32 KiB of SRAM need more than the rest.
 
 ``--ts-w``, ``--channels``, ``--cpu-variant`` and ``--sram-kib`` change a board's build for a try
 (its row says what was built). A build that does not fit its part is a row too: what it needed,
