@@ -25,8 +25,9 @@
 // configuration counts from the read on). MOT_W, TIM_W and ERR_W below are sized from P.
 //
 // The bus (the channel pages; the global registers are enc_qei_regs'): a read reads the state
-// memory's second port at once (the value as of the channel's last visit); a write is put in
-// the channel's write slot (enc_qei_ram `u_pend`, one per channel) and answered at once. The
+// memory's second port at once (the value as of the channel's last visit; answered in a fixed
+// number of clocks, see B_RD1 below); a write is put in the channel's write slot (enc_qei_ram
+// `u_pend`, one per channel) and answered at once. The
 // engine takes a write of a register the lane uses at the channel's next push (it acts from the
 // read after it) and writes its results at the visit after; a state write (EVENTS, QERR_COUNT,
 // GLITCH_COUNT, IRQ_EN, COUNT_HI) at the channel's next visit, which applies it to the values a
@@ -604,6 +605,19 @@ module enc_qei_engine #(
     end
   endfunction
 
+  // the same modulo 2^COUNT_W: COMPARE is reached across the end of the range too (the free range
+  // steps from all ones to 0 and back, and a count near 0 may be a few steps from COMPARE = all
+  // ones); equal low bits then still mean an equal count, the count staying within reach of x
+  function near_mod;
+    input [63:0] a;
+    input [63:0] b;
+    reg   [63:0] d;
+    begin
+      d        = (a - b) & SZ_COUNT;
+      near_mod = (d <= REACH64) | (((~d + 64'd1) & SZ_COUNT) <= REACH64);
+    end
+  endfunction
+
   // the validity set of a count value x, for CEILING c and COMPARE m
   function [3:0] vs_of;
     input [63:0] x;
@@ -613,7 +627,7 @@ module enc_qei_engine #(
       vs_of[V_B]  = (x <= REACH64) | (((~x + 64'd1) & SZ_COUNT) <= REACH64);
       vs_of[V_C]  = (RANGE != 0) & near(x, c);
       vs_of[V_AC] = (RANGE != 0) & (x > c);
-      vs_of[V_P]  = (RANGE != 0) & near(x, m);
+      vs_of[V_P]  = (RANGE != 0) & near_mod(x, m);
     end
   endfunction
 
@@ -1201,7 +1215,12 @@ module enc_qei_engine #(
   // A request is taken into b_* registers. A write goes into its channel's slot when the slot is
   // free and no write of the channel is being applied (a COUNT_LO write after reading COUNT and
   // the staged word: it is put there whole); a read waits alike, then reads the memory's port b.
-  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_READ = 3'd2, B_CNT = 3'd3, B_POST = 3'd4,
+  // A read takes two reads of port b (B_RD1, B_RD2) and uses the first unless the engine wrote
+  // that word in the clock of its address (b_clash: the data is undefined); the engine never
+  // writes one word in two clocks in a row, so the second is then good, and every read is
+  // answered in the same number of clocks. A COUNT_LO write with some byte lanes off reads the
+  // count alike; every other write reads nothing.
+  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_RD1 = 3'd2, B_RD2 = 3'd3, B_POST = 3'd4,
                    B_DONE = 3'd5;
   reg  [2:0]      b_st_q;
   reg             b_wr_q;
@@ -1211,6 +1230,7 @@ module enc_qei_engine #(
   reg  [3:0]      b_wstrb_q;
   reg  [31:0]     b_rdata_q;
   reg             b_resp_q;
+  reg             b_clash_q;   // the first read of port b met an engine write of its word
   reg  [4:0]      b_addr;      // the word port b reads
   reg  [31:0]     b_cnt_q;     // COUNT_LO write: the count's low word as read
   // COUNT_HI's latch (COUNT_W > 32): the high word of the last COUNT_LO read, and its channel
@@ -1221,6 +1241,8 @@ module enc_qei_engine #(
   wire b_pend      = bit_of(pend_q | busy_q, b_ch_q);
   wire b_fresh     = bit_of(fresh_q, b_ch_q);
   wire b_cnt_lo    = (b_word_q == off_of(ENC_QEI_COUNT_LO));
+  // a COUNT_LO write that keeps some of the count's bytes: it reads COUNT first
+  wire b_cnt_part  = b_wr_q & b_cnt_lo & (|b_wstrb_q) & ~(&b_wstrb_q);
   wire b_cnt_hi    = (b_word_q == off_of(ENC_QEI_COUNT_HI));
   // a COUNT_LO read first saves another channel's latch (through that channel's slot)
   wire b_save      = ~b_wr_q & (COUNT_W > 32) & b_cnt_lo & lat_valid_q & (lat_ch_q != b_ch_q);
@@ -1275,6 +1297,8 @@ module enc_qei_engine #(
   // port b must not read the word written in the same clock (enc_qei_ram: undefined); the bus
   // then reads it again in the next clock
   wire b_clash = we & (waddr == raddr_b);
+  // the clock whose port-b data the bus takes: the first read's, or the second's after a clash
+  wire b_take  = ((b_st_q == B_RD1) & ~b_clash_q) | ((b_st_q == B_RD2) & b_clash_q);
 
   // a register's value from its word (a unit the build leaves out: 0)
   localparam integer TIMING_ON = (TIMING != 0) ? 1 : 0;
@@ -1377,20 +1401,18 @@ module enc_qei_engine #(
               pend_set_st <= 1'b1;
               lat_valid_q <= 1'b0;
             end
-          end else if (~b_pend & ~b_clash) begin
-            // port b reads the register's word (a COUNT_LO write: COUNT) now, for the next clock
-            if (b_wr_q & b_cnt_lo & (|b_wstrb_q)) begin
-              b_st_q <= B_CNT;
-            end else if (b_wr_q) begin
-              b_st_q <= B_POST;
-            end else begin
-              b_st_q <= B_READ;
-            end
+          end else if (~b_pend) begin
+            // port b reads the register's word (a COUNT_LO write: COUNT) now and in the next
+            // clock; a write that reads nothing is posted
+            b_clash_q <= b_clash;
+            b_st_q    <= (b_wr_q & ~b_cnt_part) ? B_POST : B_RD1;
           end
         end
-        B_CNT: begin  // the count's low word is here
-          b_cnt_q <= b_fresh ? 32'd0 : rdata_b[31:0];
-          b_st_q  <= B_POST;
+        B_RD1: begin  // the first read's data (taken when good), the second read
+          b_st_q <= B_RD2;
+        end
+        B_RD2: begin  // the second read's data (taken when the first was not good)
+          b_st_q <= b_wr_q ? B_POST : B_DONE;
         end
         B_POST: begin
           pend_we    <= 1'b1;
@@ -1400,16 +1422,6 @@ module enc_qei_engine #(
           pend_set_st <= b_state_wr;
           b_st_q      <= B_DONE;
         end
-        B_READ: begin
-          if ((COUNT_W > 32) & b_cnt_lo) begin
-            lat_valid_q <= 1'b1;
-            lat_ch_q    <= b_ch_q;
-            lat_q       <= b_word[63:32];
-          end
-          b_rdata_q <= ((COUNT_W > 32) & b_cnt_hi & lat_valid_q & (lat_ch_q == b_ch_q)) ? lat_q :
-                       reg_of(b_word_q, b_word);
-          b_st_q    <= B_DONE;
-        end
         default: begin  // B_DONE
           if (b_wr_q) begin
             b_rdata_q <= 32'd0;
@@ -1418,6 +1430,18 @@ module enc_qei_engine #(
           b_st_q   <= B_IDLE;
         end
       endcase
+      if (b_take & b_wr_q) begin  // (a COUNT_LO write keeping some bytes: the count's low word)
+        b_cnt_q <= b_fresh ? 32'd0 : rdata_b[31:0];
+      end
+      if (b_take & ~b_wr_q) begin
+        if ((COUNT_W > 32) & b_cnt_lo) begin
+          lat_valid_q <= 1'b1;
+          lat_ch_q    <= b_ch_q;
+          lat_q       <= b_word[63:32];
+        end
+        b_rdata_q <= ((COUNT_W > 32) & b_cnt_hi & lat_valid_q & (lat_ch_q == b_ch_q)) ? lat_q :
+                     reg_of(b_word_q, b_word);
+      end
     end
   end
 

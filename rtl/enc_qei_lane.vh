@@ -112,7 +112,7 @@ localparam integer REC_W     = R_UD + TIM_W;      // the record's width
 // COMPARE. A validity set says, for a count near its value, which of these the lane's low bits
 // may stand for: V_B the end of the range (0 / all ones, within reach either way round), V_C
 // CEILING (within reach), V_AC the count is above CEILING (when not V_C), V_P COMPARE (within
-// reach).
+// reach modulo 2^COUNT_W: across the end of the free range too).
 localparam integer V_B = 0, V_C = 1, V_AC = 2, V_P = 3, VS_W = 4;
 localparam integer C_EN       = 0;
 localparam integer C_SWAP     = 1;

@@ -29,7 +29,8 @@ async def coherent_64bit(dut):
     """COUNT_LO then COUNT_HI is one value while the count carries across bit 32 between them.
     (Whether a carry fell between the two reads: from the core's count, or with the shared engine,
     whose count is in its memory, from the stimulus: the pins had not crossed it at the COUNT_LO
-    read and had crossed it more than the engine's latency before the COUNT_HI read.)"""
+    read and had crossed it more than the engine's latency before the COUNT_HI read; one pair of
+    reads per pass is timed to start just before the pins cross it.)"""
     env, rng = await begin(dut)
     if env.count_w <= 32:
         # COUNT_HI reads 0, LO is the whole count
@@ -55,7 +56,12 @@ async def coherent_64bit(dut):
         carry_clk = (t0 + wf.events[60][0]) / T_NS
         task = cocotb.start_soon(env.drv.play(wf))
         last = start_count
+        aimed = live is not None  # (the engine: one pair per pass aimed at the carry)
         while not task.done():
+            now = get_sim_time("ns") / T_NS
+            if not aimed and now < carry_clk - 25:
+                await ClockCycles(dut.clk, int(carry_clk - now) - rng.randint(5, 20))
+                aimed = True
             lo = await env.bus.rd("COUNT_LO")
             if live is not None:
                 hi_live_at_lo = int(live.value) >> 32

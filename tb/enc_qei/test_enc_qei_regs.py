@@ -164,6 +164,9 @@ def test_rdl_has_the_multi_axis_names():
     profile = _reg("CAPS").get_child_by_name("PROFILE").get_property("encode")
     assert {m.name for m in profile} >= {"full", "lean"}
     assert _reg("CAPS").get_child_by_name("CHANNELS") is not None
+    # the shared engine's part: CAPS.ENGINE an enum with exactly per_channel and shared
+    engine = _reg("CAPS").get_child_by_name("ENGINE").get_property("encode")
+    assert {m.name: m.value for m in engine} == {"per_channel": 0, "shared": 1}
     for name in ("COUNT_LO", "SNAP_COUNT_LO", "EVENTS", "IRQ_EN", "SNAP_CTRL"):
         assert groups.get(name) == "chan", f"{name} is not a channel register"
 

@@ -8,9 +8,12 @@ the same, shown at once):
   event in EVENTS, a level in STATUS, an index latch in INDEX_LATCH, a quadrature error in
   QERR_COUNT and a global snapshot in SNAP_TIME at most P + 44 later, irq and IRQ_SUMMARY rise at
   most P + 44 later (measured to the clock at every phase of the engine's reads of a channel);
-- a bus write is answered in 4 clocks (2 per channel) and acts once, at most P + 18 clocks after
-  its request (a COUNT_LO write), or P + 26 (EVENTS, QERR_COUNT: on what a read could show at
-  the request, an event after it stays), in order with the reads and writes after it;
+- a bus write is answered in 4 clocks, a read in 5 (a COUNT_LO write keeping some bytes in 6; 2
+  per channel), at every phase; a write acts once, at most P + 18 clocks after its request (a
+  COUNT_LO write), or P + 26 (EVENTS, QERR_COUNT: on what a read could show at the request, an
+  event after it stays), in order with the reads and writes after it; a read right after a write
+  sees it and is answered at most P + 66 clocks after the write's request (P + 30 after a state
+  write), and at some phase that late;
 - every value exact: independent clock-exact random walks on every channel at the count-rate bound
   with index presets and latches, global snapshots every few hundred clocks, each channel against
   its own model; channels isolated from each other's bus traffic; reset in mid-motion;
@@ -32,7 +35,8 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from enctools.qei.bus import WbRaw, signed
-from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_SHOW, ENGINE_SHOW_COUNT,
+from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
+                              ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT, ENGINE_STATE_WAIT,
                               ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin, build_name,
                               channel_envs, engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
@@ -252,6 +256,17 @@ def index_pulses(rng, n):
     return out
 
 
+async def global_snapshot(env, envs, walker, rng, t_prev, what) -> int:
+    """A global snapshot by command while walker walks; up to four channels' SNAP_* checked against
+    their Timelines; returns its (unwrapped) timebase."""
+    await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+    await env.settle()
+    t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
+    for k in rng.sample(range(len(envs)), min(len(envs), 4)):
+        await check_snapshot(envs[k], walker.lines[k], t, t_prev, f"{what}, channel {k}")
+    return t
+
+
 async def check_snapshot(env, line, t, t_prev, what) -> None:
     """Channel env's SNAP_* against its Timeline at (unwrapped) timebase t; t_prev: the timebase of
     the channel's capture before (None: unknown)."""
@@ -308,12 +323,7 @@ async def random_motion(dut):
     t_prev = None  # the last global snapshot's timebase
     for i in range(snaps):
         await ClockCycles(dut.clk, rng.randint(100, 400))
-        await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
-        await env.settle()
-        t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
-        for k in rng.sample(range(n), min(n, 4)):
-            await check_snapshot(envs[k], walker.lines[k], t, t_prev, f"global snapshot {i}, channel {k}")
-        t_prev = t
+        t_prev = await global_snapshot(env, envs, walker, rng, t_prev, f"global snapshot {i}")
     task.cancel()
     await env.settle()
     for k, (e, m) in enumerate(zip(envs, models)):
@@ -331,10 +341,10 @@ GLOBAL_REGS = ("ID", "CAPS", "TIMEBASE", "TB_PRESCALE", "GSNAP_CTRL", "GSNAP_PER
                "IRQ_SUMMARY")
 
 
-async def answered(raw: WbRaw, adr: int, data: int | None = None) -> int:
+async def answered(raw: WbRaw, adr: int, data: int | None = None, sel: int = 0xF) -> int:
     """Clocks from an access's request to its answer (WbRaw's stamp: the clock before the request
     is sampled; its return: the falling edge after the acknowledge)."""
-    stamp, _, err = await raw.access(adr, data)
+    stamp, _, err = await raw.access(adr, data, sel=sel)
     assert not err, f"access of {adr:#x} answered an error"
     return int(raw.tb.value) - stamp
 
@@ -343,14 +353,15 @@ async def answered(raw: WbRaw, adr: int, data: int | None = None) -> int:
 async def answer_times(dut):
     """Every channel register of a random channel, read, then written with what it read (a COUNT_LO
     write: count_lo_write_answer), at random phases of the engine's reads, each when no write of
-    the channel waits: answered ENGINE_ANSWER clocks after its request on the engine,
-    PER_CHANNEL_ANSWER on the per-channel build (the RDL); the global registers in
-    PER_CHANNEL_ANSWER on both."""
+    the channel waits: a read answered ENGINE_READ_ANSWER clocks after its request on the engine,
+    a write ENGINE_ANSWER, both PER_CHANNEL_ANSWER on the per-channel build (the RDL); the global
+    registers in PER_CHANNEL_ANSWER on both. Random phases include the clocks in which the engine
+    writes the register's word (a read taken then must still be answered in time)."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     raw = WbRaw(dut)
     wait = engine_period(n) + ENGINE_WAIT if env.engine else 2
-    want = ENGINE_ANSWER if env.engine else PER_CHANNEL_ANSWER
+    want = (ENGINE_READ_ANSWER, ENGINE_ANSWER) if env.engine else (PER_CHANNEL_ANSWER,) * 2
     late = []
     for reg in CHAN_REGS + GLOBAL_REGS:
         k = rng.randrange(n) if reg in CHAN_REGS else 0
@@ -360,27 +371,30 @@ async def answer_times(dut):
         value = (await raw.access(adr))[1]
         await ClockCycles(dut.clk, wait + rng.randrange(engine_period(n)))
         put = None if reg == "COUNT_LO" else await answered(raw, adr, value)
-        exp = want if reg in CHAN_REGS else PER_CHANNEL_ANSWER
-        if got != exp or put not in (None, exp):
+        exp = want if reg in CHAN_REGS else (PER_CHANNEL_ANSWER,) * 2
+        if got != exp[0] or put not in (None, exp[1]):
             late.append((reg, got, put))
-    assert not late, f"answered not {want} (channel registers) / {PER_CHANNEL_ANSWER} (global ones) " \
-                     f"clocks after the request (register, read, write): {late}"
+    assert not late, f"answered not {want} (channel registers: read, write) / {PER_CHANNEL_ANSWER} " \
+                     f"(global ones) clocks after the request (register, read, write): {late}"
 
 
 @cocotb_test()
 async def count_lo_write_answer(dut):
     """A COUNT_LO write, when no write of its channel waits, is answered ENGINE_ANSWER clocks after
-    its request on the engine (the RDL: "a read or a write of a channel register is answered 4
-    clocks after its request"), PER_CHANNEL_ANSWER on the per-channel build."""
+    its request on the engine with all byte enables set, ENGINE_PART_ANSWER with some (it reads
+    the count for the bytes it keeps: the RDL), PER_CHANNEL_ANSWER on the per-channel build; at
+    random phases of the engine's reads, so also in the clock the engine writes the count."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     raw = WbRaw(dut)
-    want = ENGINE_ANSWER if env.engine else PER_CHANNEL_ANSWER
-    seen = set()
-    for _ in range(8):
-        await ClockCycles(dut.clk, engine_period(n) + ENGINE_WAIT + rng.randrange(engine_period(n)))
-        seen.add(await answered(raw, addr("COUNT_LO", rng.randrange(n)), rng.getrandbits(32)))
-    assert seen == {want}, f"COUNT_LO writes answered {sorted(seen)} clocks after the request, not {want}"
+    for sel, want in ((0xF, ENGINE_ANSWER), (0x3, ENGINE_PART_ANSWER), (0x8, ENGINE_PART_ANSWER)):
+        want = want if env.engine else PER_CHANNEL_ANSWER
+        seen = set()
+        for _ in range(8):
+            await ClockCycles(dut.clk, engine_period(n) + ENGINE_WAIT + rng.randrange(engine_period(n)))
+            seen.add(await answered(raw, addr("COUNT_LO", rng.randrange(n)), rng.getrandbits(32), sel))
+        assert seen == {want}, f"COUNT_LO writes (byte enables {sel:#x}) answered {sorted(seen)} " \
+                               f"clocks after the request, not {want}"
 
 
 @cocotb_test()
@@ -438,6 +452,45 @@ async def write_effect(dut):
         got = (await raw.access(addr("COUNT_LO", k)))[1]
         assert got == old & ~lanes | new & lanes, \
             f"channel {k}: COUNT_LO {old:#x}, written {new:#x} with byte enables {strb:#x}: {got:#x}"
+
+
+@cocotb_test()
+async def read_after_write_wait(dut):
+    """A write of a channel, then at once a read of the same register (it must see the write),
+    at every phase of the engine's visits: the read is answered at most P + ENGINE_WAIT clocks
+    after the write's request (a state write, IRQ_EN: P + ENGINE_STATE_WAIT; the RDL), and at some
+    phase within 2 clocks of that (the bound is the real one).
+    Per-channel build: the read answered PER_CHANNEL_ANSWER after its own request."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    p = engine_period(n) if env.engine else 2
+    worst = {}
+    for reg, mask, bound in (("PRESET_LO", 0xFFFFFFFF, ENGINE_WAIT),
+                             ("IRQ_EN", 0x3FF, ENGINE_STATE_WAIT)):
+        worst[reg] = 0
+        for rel in range(p):
+            k = rng.randrange(n)
+            value = rng.getrandbits(32) & mask
+            await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
+            w, _, _ = await raw.access(addr(reg, k), value)
+            r, got, _ = await raw.access(addr(reg, k))
+            done = int(raw.tb.value)
+            assert got == value, f"channel {k}: {reg} written {value:#x}, read right after: {got:#x}"
+            if env.engine:
+                assert done - w <= p + bound, \
+                    f"channel {k}: {reg} read right after a write answered {done - w} clocks after " \
+                    f"the write's request (bound P + {bound}, P {p})"
+            else:
+                assert done - r == PER_CHANNEL_ANSWER, f"{reg}: read answered {done - r} clocks"
+            worst[reg] = max(worst[reg], done - w - p)
+            await ClockCycles(dut.clk, p + ENGINE_WAIT)
+        dut._log.info("a read of %s right after a write answered at worst P + %d clocks after the "
+                      "write's request (bound P + %d, P %d)", reg, worst[reg], bound, p)
+        if env.engine:
+            assert worst[reg] >= bound - 2, \
+                f"the worst read of {reg} after a write was answered at P + {worst[reg]}: the " \
+                f"RDL's P + {bound} is loose"
 
 
 @cocotb_test()
@@ -593,11 +646,7 @@ async def reset_mid_motion(dut):
                            p_reverse=0.3)
         task = cocotb.start_soon(walker.run(10 ** 9))
         await ClockCycles(dut.clk, rng.randint(100, 300))
-        await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
-        await env.settle()
-        t = walker.unwrap(await env.bus.rd("GSNAP_TIME"))
-        for k in rng.sample(range(n), min(n, 4)):
-            await check_snapshot(envs[k], walker.lines[k], t, None, f"after reset {rep}, channel {k}")
+        await global_snapshot(env, envs, walker, rng, None, f"after reset {rep}")
         task.cancel()
         await env.settle()
         for k, (e, m) in enumerate(zip(envs, models)):
@@ -826,9 +875,12 @@ def test_rdl_says_the_bounds():
         "ENGINE_IRQ": r"irq and IRQ_SUMMARY rise and fall at most P \+ (\d+) clocks",
         "ENGINE_ACT": r"acts at the channel's first read after it, at most P \+ (\d+) clocks",
         "ENGINE_STATE_ACT": r"COUNT_HI acts \(irq included\) at most P \+ (\d+) clocks",
-        "ENGINE_WAIT": r"has not acted \(at most P \+ (\d+) clocks\)",
-        "ENGINE_ANSWER": r"answered (\d+) clocks after its request",
-        "PER_CHANNEL_ANSWER": r"answered \d+ clocks after its request \((\d+) in a per_channel build\)",
+        "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
+        "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
+        "ENGINE_ANSWER": r"a write of a channel register is answered (\d+) clocks after its request",
+        "ENGINE_READ_ANSWER": r"a read (\d+) clocks after its request",
+        "ENGINE_PART_ANSWER": r"a COUNT_LO write with some but not all byte enables set (\d+)",
+        "PER_CHANNEL_ANSWER": r"a read \d+ clocks after its request \((\d+) in a per_channel build\)",
     }
     for name, pattern in said.items():
         m = re.search(pattern, text)
@@ -839,13 +891,13 @@ def test_rdl_says_the_bounds():
 
 # what each register's own RDL text must state for the shared engine (the contract: "the RDL text
 # of that register gives the bound in clocks as a formula in CHANNELS"): P + the env constant
-SHOWN = ("STATUS", "INDEX_LATCH_LO", "INDEX_LATCH_HI", "PROBE_LATCH_LO", "PROBE_LATCH_HI",
+SHOWN_REGS = ("STATUS", "INDEX_LATCH_LO", "INDEX_LATCH_HI", "PROBE_LATCH_LO", "PROBE_LATCH_HI",
          "PROBE_TIME", "EVENTS", "QERR_COUNT", "GLITCH_COUNT", "SNAP_COUNT_LO", "SNAP_COUNT_HI",
          "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA", "SNAP_EDGE_DELTA", "PERIOD", "IRQ_SUMMARY")
-ACTING = ("CTRL", "COUNT_LO", "PRESET_LO", "PRESET_HI", "CEILING_LO", "CEILING_HI", "COMPARE_LO",
+ACTING_REGS = ("CTRL", "COUNT_LO", "PRESET_LO", "PRESET_HI", "CEILING_LO", "CEILING_HI", "COMPARE_LO",
           "COMPARE_HI", "INDEX_CTRL", "PROBE_CTRL", "SNAP_CTRL", "SNAP_PERIOD", "PERIOD_CTRL",
           "STALL_TIMEOUT")
-STATE_ACTING = ("EVENTS", "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "COUNT_HI")
+STATE_ACTING_REGS = ("EVENTS", "IRQ_EN", "QERR_COUNT", "GLITCH_COUNT", "COUNT_HI")
 
 
 def test_registers_state_their_bounds():
@@ -863,17 +915,17 @@ def test_registers_state_their_bounds():
                         [f.get_property("desc") or "" for f in r.fields()])
         for m in re.finditer(rf"{env.ENGINE_VISIT} \* max\(CHANNELS, 2\) \+ (\d+)", " ".join(text.split())):
             said.setdefault(r.inst_name, set()).add(int(m.group(1)))
-    want = {r: {env.ENGINE_SHOW} for r in SHOWN}
+    want = {r: {env.ENGINE_SHOW} for r in SHOWN_REGS}
     want["COUNT_LO"] = {env.ENGINE_SHOW_COUNT}
-    for r in ACTING:
+    for r in ACTING_REGS:
         want.setdefault(r, set()).add(env.ENGINE_ACT)
-    for r in STATE_ACTING:
+    for r in STATE_ACTING_REGS:
         want.setdefault(r, set()).add(env.ENGINE_STATE_ACT)
     for r, bounds in want.items():
         missing = bounds - said.get(r, set())
         assert not missing, f"{r}: its RDL text does not state P + {sorted(missing)}"
     known = {env.ENGINE_SHOW, env.ENGINE_SHOW_COUNT, env.ENGINE_ACT, env.ENGINE_STATE_ACT,
-             env.ENGINE_WAIT, env.ENGINE_IRQ}
+             env.ENGINE_WAIT, env.ENGINE_STATE_WAIT, env.ENGINE_IRQ}
     for r, bounds in said.items():
         assert bounds <= known, f"{r}: its RDL text states P + {sorted(bounds - known)}, a bound " \
                                 f"CAPS.ENGINE's text does not give"

@@ -172,6 +172,8 @@ async def period_en_rewrite_and_restart(dut):
             w, _ = await write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1, CMD=cmd))
             rewrites.append((w + lat, cmd))   # (its snapshot clock, with a CMD)
         await ClockCycles(dut.clk, 2 * period)
+        if env.engine:  # (at least five timer periods the engine has shown)
+            await ClockCycles(dut.clk, max(1, start + 6 * period + engine_period(channels) - trace.now()))
         end = trace.now()
         cmds = {c for c, with_cmd in rewrites if with_cmd}
         if env.engine:  # the timer's grid and the commands, some of them deferred

@@ -108,6 +108,7 @@ async def bounded_range_fast(dut):
         await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
         model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
         model.idx_gate, model.idx_arm = None, True
+        await env.applied()  # (the shared engine: PRESET and INDEX_CTRL act before the walk)
         wf = random_walk(rng, 400, 1.05 * T_NS + 0.1, 2.1 * T_NS, p_reverse=0.5, start_pos=env.pos)
         await env.play(wf, model, zfun=lambda p: int(p % 7 == 0))
         await env.check(model, f"{mode} CEILING {ceiling:#x} PRESET {preset:#x} fast")

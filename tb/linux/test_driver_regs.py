@@ -24,7 +24,8 @@ DRIVER = TOP / "sw" / "linux" / "drivers" / "counter" / "enc-qei.c"
 # fields the driver is written for that the RDL may not have yet (they must match once it does)
 PENDING = {("CTRL", "CMP_EN")}
 NOT_REGMAP = {"PAGE_SIZE", "MAGIC", "VERSION_MAJOR", "VERSION_MINOR_MIN", "MAX_CHANNELS",
-              "FILTER_LEN_MAX", "EV_ALL", "SIGNAL_A", "SIGNAL_B", "SIGNAL_INDEX"}
+              "FILTER_LEN_MAX", "EV_ALL", "SIGNAL_A", "SIGNAL_B", "SIGNAL_INDEX",
+              "ENGINE_VISIT_CLOCKS", "ENGINE_MIN_VISITS", "SNAPSHOT_TIMEOUT_US"}
 
 
 def defines() -> dict[str, str]:

@@ -34,6 +34,7 @@ RELATIONAL = [(top, params, ok, name) for top in ("enc_qei_wb", "enc_qei_axil")
     ({"ENGINE": 1, "PROFILE": 3, "EFIFO_LOG2": 8, "CHANNELS": 2}, False, "EFIFO_LOG2"),
     ({"ENGINE": 1, "PROFILE": 3, "CHANNELS": 16}, True, ""),
     ({"ENGINE": 1, "CHANNELS": 3}, True, ""),
+    ({"ENGINE": 1, "PROFILE": 1, "CHANNELS": 2}, True, ""),
 )]
 
 

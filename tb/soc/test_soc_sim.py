@@ -11,8 +11,9 @@ linked) and with the double one (FW_VEL=double). The firmware built with FW_FAUL
 register from the wrong channel page, and the same check must fail on it. The edge-FIFO build
 (simsoc.EFIFO: 3 channels, 256 entries each) runs the same firmware, which drains the FIFOs;
 check.check_efifo compares the entries with the model's steps, and must fail on the firmware
-built with FW_FAULT=efifo (an entry's direction from the wrong bit). A third build (simsoc.ENGINE:
-the lean profile, the channels sharing one engine) runs the same firmware. The main and the
+built with FW_FAULT=efifo (an entry's direction from the wrong bit). Two more builds
+(simsoc.ENGINE and simsoc.ENGINE_FULL: lean and full channels sharing one engine) run the same
+firmware. The main and the
 edge-FIFO builds read one unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and
 reads all ones.
 
@@ -178,11 +179,14 @@ def test_wrong_efifo_field_fails_the_check():
     assert not fifo.ok and [m for w, m in fifo.failures if w == "efifo"], fifo.failures
 
 
-def test_shared_engine_build():
-    """The same firmware on the lean profile with the channels sharing one engine (CAPS.ENGINE =
-    shared): the driver's snapshots, positions and velocities pass every check there too."""
-    run, res, _ = _run(cfg=simsoc.ENGINE)
-    assert run.build["engine"] == 1 and run.build["profile"] == 3
+@pytest.mark.parametrize("cfg, profile", [(simsoc.ENGINE, 3), (simsoc.ENGINE_FULL, 2)],
+                         ids=["lean", "full"])
+def test_shared_engine_build(cfg, profile):
+    """The same firmware on lean and on full channels sharing one engine (CAPS.ENGINE = shared):
+    the driver's snapshots, positions and velocities pass every check there too."""
+    run, res, _ = _run(cfg=cfg)
+    assert run.build["engine"] == 1 and run.build["profile"] == profile
+    assert run.build["channels"] == cfg.channels
     assert res.ok, res.failures
 
 

@@ -397,7 +397,7 @@ static void check_kunit(void)
 			n++;
 		}
 	}
-	result(n >= 6, "kunit: %d test cases reported", n);
+	result(n >= 7, "kunit: %d test cases reported", n);
 }
 
 /* A write the driver must refuse with err, leaving the attribute as it was */

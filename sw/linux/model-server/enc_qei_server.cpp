@@ -9,11 +9,34 @@
 // status}. op 1 reads the register at byte address addr (one Wishbone access), op 2 writes data
 // with byte enables sel, op 3 advances the encoders by data motion steps (sw/linux/stimulus.h:
 // each step's inputs held for ENC_STIM_STEP_CLOCKS clocks). status is 1 when the peripheral
-// answered with wb_err_o (or the address is outside its ADDR_W bits), else 0. After every request
-// and before its answer, the server sends one byte on the interrupt connection if the irq output
-// rose since the last one it reported. --id makes reads of ID answer WORD instead of the RTL's ID
-// (the driver's refusal of a wrong ID or version is tested with it). The parameters of the build
-// (CHANNELS, PROFILE, COUNT_W, TS_W, FUNC_MASK, ADDR_W) are Verilator -G options of the model;
+// answered with wb_err_o or not at all (see the bound below), or the address is outside its
+// ADDR_W bits, else 0. After every request and before its answer, the server sends one byte on the
+// interrupt connection if the irq output rose since the last one it reported.
+//
+// A build whose channels share one engine (CAPS.ENGINE = shared, rtl/enc_qei.rdl) shows a change
+// later and lets a write act later, by bounds in clocks of P = 24 * max(CHANNELS, 2). The server
+// keeps the motion clear of them, so that what every register shows after N motion steps is what
+// a per_channel build shows: an advance starts with P + 22 idle clocks (a write answered before
+// it acts by then: P + 14 after its answer for CTRL and the other registers the counting uses,
+// P + 22 for EVENTS, IRQ_EN, COUNT_HI and the error counts) and ends, after the last step's
+// ENC_STIM_STEP_CLOCKS, with P + 44 more (a change the per_channel build shows within the step
+// shows by then, irq included). The steps keep their spacing: the engine's channels count in the
+// clocks a per_channel build does.
+//
+// The RDL bounds the answer to an access: 2 clocks after its request on a per_channel build; on
+// the shared engine 6 (a read 5, a write 4, a COUNT_LO write with some byte lanes 6, a COUNT_LO
+// read of another channel 6), and an access of a channel waits until that channel's writes are
+// stored: one right after a write is answered at most P + 66 clocks after the write's request.
+// The server holds every access to that bound, counted from the last write of the same 0x100-byte
+// page (a channel); for a write that itself waited for an earlier one, from its answer less 6
+// clocks, as if it had been requested then and not waited (the RDL states the bound for a write
+// that did not wait). It names the first 8 answers later than that (with the access before),
+// prints their count and the longest answer at exit, and gives up on an access after four times
+// P + 66 clocks, plus 16 (a bus error, and a line "no answer").
+//
+// --id makes reads of ID answer WORD instead of the RTL's ID (the driver's refusal of a wrong ID
+// or version is tested with it). The parameters of the build (CHANNELS, PROFILE, COUNT_W, TS_W,
+// FUNC_MASK, ENGINE, ADDR_W) are Verilator -G options of the model;
 // ENC_QEI_ADDR_W (a -D option) is the same ADDR_W.
 // The server exits when the request connection closes.
 #include <cerrno>
@@ -42,6 +65,16 @@ Venc_qei_wb *top;
 struct enc_stim stim[kMaxChannels];
 int channels;
 uint64_t clocks;
+int answer_bound = 2;       // clocks from a request to its answer, at most, by the RDL (above)
+int after_write_bound = 2;  // clocks from a write's request to the answer of the access after it
+int longest_answer;         // the longest seen
+uint64_t late_answers;      // answers later than answer_bound
+uint32_t prev_addr;         // the access before (for the report of a late answer)
+bool prev_we;
+uint64_t prev_request;
+constexpr int kPages = 64;  // 0x100-byte pages of the address space (a channel's registers)
+uint64_t last_write[kPages];  // each page's last write: its request, or for a write that waited
+                              // its answer less answer_bound
 
 void tick() {
     top->clk = 0;
@@ -65,6 +98,7 @@ void drive_inputs() {
 
 // One Wishbone access; returns the status (0 ack, 1 err) and the read data in *data.
 uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
+    const uint64_t request = clocks;
     top->wb_adr_i = addr;
     top->wb_dat_i = *data;
     top->wb_sel_i = sel;
@@ -74,17 +108,39 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     top->eval();
     uint32_t status = 1;
     *data = 0;
-    for (int i = 0; i < 16; i++) {
+    const int give_up = 4 * after_write_bound + 16;
+    for (int i = 1; i <= give_up; i++) {
         tick();
         if (top->wb_ack_o || top->wb_err_o) {
             status = top->wb_err_o ? 1 : 0;
             *data = top->wb_dat_o;
+            if (i > longest_answer)
+                longest_answer = i;
+            const uint64_t since_write = request + i - last_write[addr >> 8 & (kPages - 1)];
+            const bool late = i > answer_bound &&
+                since_write > static_cast<uint64_t>(after_write_bound);
+            if (late && late_answers++ < 8)
+                fprintf(stderr, "enc_qei_server: late answer: a %s of 0x%03x answered %d clocks "
+                        "after its request (clock %llu), %llu after a %s of 0x%03x\n",
+                        we ? "write" : "read", addr, i, static_cast<unsigned long long>(request),
+                        static_cast<unsigned long long>(request - prev_request),
+                        prev_we ? "write" : "read", prev_addr);
             break;
         }
     }
+    if (!top->wb_ack_o && !top->wb_err_o)
+        fprintf(stderr, "enc_qei_server: no answer to a %s of 0x%03x within %d clocks\n",
+                we ? "write" : "read", addr, give_up);
     top->wb_cyc_i = 0;
     top->wb_stb_i = 0;
     tick();
+    prev_addr = addr;
+    prev_we = we;
+    prev_request = request;
+    // a write that waited itself counts from its answer less answer_bound (see the top)
+    if (we)
+        last_write[addr >> 8 & (kPages - 1)] =
+            clocks - 1 - answer_bound > request ? clocks - 1 - answer_bound : request;
     return status;
 }
 
@@ -145,14 +201,14 @@ int main(int argc, char **argv) {
     Verilated::commandArgs(argc, argv);
     top = new Venc_qei_wb;
     channels = static_cast<int>(sizeof(top->a_in) * 8);
+    uint32_t caps = 0;
     {
-        // the number of channels from CAPS, after reset
+        // the number of channels and the architecture from CAPS, after reset
         top->rst = 1;
         for (int i = 0; i < 4; i++)
             tick();
         top->rst = 0;
         tick();
-        uint32_t caps = 0;
         access(4, false, &caps, 0xf);
         channels = static_cast<int>((caps >> 22) & 0x1f);
         if (channels < 1 || channels > kMaxChannels) {
@@ -160,6 +216,12 @@ int main(int argc, char **argv) {
             return 1;
         }
     }
+    // the shared engine's bounds (CAPS.ENGINE, bit 31): see the top of this file
+    const bool engine = caps >> 31;
+    const int p = 24 * (channels > 2 ? channels : 2);
+    const int settle_before = engine ? p + 22 : 0, settle_after = engine ? p + 44 : 0;
+    if (engine)
+        answer_bound = 6, after_write_bound = p + 66;
     for (int k = 0; k < channels; k++)
         enc_stim_init(&stim[k], static_cast<unsigned>(k));
     drive_inputs();
@@ -167,7 +229,8 @@ int main(int argc, char **argv) {
         tick();
     const uint32_t addr_limit = 1u << ENC_QEI_ADDR_W;  // the bus port's byte-address bits
 
-    printf("enc_qei_server: %d channels, listening on %s\n", channels, path);
+    printf("enc_qei_server: %d channels, %s, listening on %s\n", channels,
+           engine ? "shared engine" : "per_channel", path);
     fflush(stdout);
     int bus = accept(lfd, nullptr, nullptr);
     int irq = accept(lfd, nullptr, nullptr);
@@ -193,6 +256,8 @@ int main(int argc, char **argv) {
             if (req[0] == kOpRead && req[1] == 0 && id_override)
                 resp[0] = id_word;
         } else if (req[0] == kOpAdvance) {
+            for (int c = 0; c < settle_before; c++)
+                tick();
             for (uint32_t i = 0; i < req[2]; i++) {
                 for (int k = 0; k < channels; k++)
                     enc_stim_next(&stim[k]);
@@ -200,6 +265,8 @@ int main(int argc, char **argv) {
                 for (int c = 0; c < ENC_STIM_STEP_CLOCKS; c++)
                     tick();
             }
+            for (int c = 0; c < settle_after; c++)
+                tick();
             steps += req[2];
         } else {
             fprintf(stderr, "enc_qei_server: unknown request op %u\n", req[0]);
@@ -214,9 +281,12 @@ int main(int argc, char **argv) {
         if (!full_io(bus, resp, sizeof(resp), false))
             break;
     }
-    printf("enc_qei_server: %llu accesses, %llu motion steps, %llu clocks\n",
+    printf("enc_qei_server: %llu accesses, %llu motion steps, %llu clocks; answers: the longest "
+           "%d clocks after its request, %llu later than the bound of %d (%d from a write's "
+           "request after it)\n",
            static_cast<unsigned long long>(accesses), static_cast<unsigned long long>(steps),
-           static_cast<unsigned long long>(clocks));
+           static_cast<unsigned long long>(clocks), longest_answer,
+           static_cast<unsigned long long>(late_answers), answer_bound, after_write_bound);
     top->final();
     delete top;
     unlink(path);

@@ -47,6 +47,26 @@ class Outcome:
     console: str
     seconds: float
     finished: bool
+    answers: str = ""           # the model server's bus answers against the RDL's bound
+
+
+ANSWERS_RE = re.compile(r"answers: the longest (\d+) clocks after its request, (\d+) later than "
+                        r"the bound of (\d+) \((\d+) from a write's request after it\)")
+
+
+def answers_result(text: str) -> tuple[bool, str]:
+    """The model server's bus answers against the RDL's bounds (its last line; the late ones, up to
+    8, are named in the console log as "late answer"; an access not answered at all is a bus
+    error and a line "no answer")."""
+    m = ANSWERS_RE.search(text)
+    if not m:
+        return False, "the model server did not report its bus answers"
+    longest, late, bound, after_write = map(int, m.groups())
+    unanswered = text.count("enc_qei_server: no answer")
+    return late == 0 and unanswered == 0, (
+        f"bus answers within the RDL's bounds: {bound} clocks from the request, {after_write} "
+        f"from a write's request for the access after it: {late} later, {unanswered} not "
+        f"answered, the longest {longest}")
 
 
 def dts(b: Boot) -> str:
@@ -188,7 +208,9 @@ def run(b: Boot, linux: Path, server: Path, dtc: Path, module: Path, init: Path,
     text = "".join(console).replace("\r\n", "\n") + server_out
     (work / "console.log").write_text(text)
     results, finished = parse(text)
+    answers = answers_result(text)
+    results.append(answers)
     for pattern in b.expect:
         results.append((re.search(pattern, text, re.M) is not None,
                         f"console shows /{pattern}/"))
-    return Outcome(b, results, text, time.monotonic() - t0, finished)
+    return Outcome(b, results, text, time.monotonic() - t0, finished, answers[1])

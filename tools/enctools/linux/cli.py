@@ -15,6 +15,11 @@ from . import binding, boot, kernel, model
 FULL4 = model.Build("full4", {"CHANNELS": 4, "PROFILE": 2, "COUNT_W": 32, "TS_W": 32})
 LEAN2 = model.Build("lean2", {"CHANNELS": 2, "PROFILE": 3, "COUNT_W": 64, "TS_W": 16,
                               "FUNC_MASK": 1})
+# the same tests with the channels sharing one engine (CAPS.ENGINE = shared): the full test needs
+# channels 0 to 3; the lean one runs on 3 channels (P = 72 clocks, a channel count that is not a
+# power of two)
+FULL4_ENGINE = model.Build("full4-engine", {**FULL4.params, "ENGINE": 1})
+LEAN3_ENGINE = model.Build("lean3-engine", {**LEAN2.params, "CHANNELS": 3, "ENGINE": 1})
 WANT_VERSION = 0x0102  # the register map the driver is written for (ENC_QEI_VERSION_MINOR_MIN)
 
 
@@ -24,6 +29,12 @@ def boots(present_id: int | None) -> list[boot.Boot]:
                   [r"enc-qei 10000000\.encoder: 4 channels, 32-bit counts, full profile$"]),
         boot.Boot("lean2-noirq", LEAN2, "lean", False, present_id,
                   [r"2 channels, 64-bit counts, lean profile, no interrupt: no events$"]),
+        boot.Boot("full4-engine", FULL4_ENGINE, "full", True, present_id,
+                  [r"enc-qei 10000000\.encoder: 4 channels, 32-bit counts, full profile, "
+                   r"shared engine$"]),
+        boot.Boot("lean3-engine-noirq", LEAN3_ENGINE, "lean", False, present_id,
+                  [r"3 channels, 64-bit counts, lean profile, shared engine, no interrupt: "
+                   r"no events$"]),
         boot.Boot("wrong-id", FULL4, "refuse", True, 0x12345678,
                   [r"error -19: not an enc_qei \(ID 0x12345678\)"]),
         boot.Boot("wrong-version", FULL4, "refuse", True, 0x51450201,
@@ -37,8 +48,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--jobs", type=int, default=2, help="parallel jobs of the builds")
     ap.add_argument("--boot", action="append", default=[],
-                    help="run only this boot (repeatable): full4, lean2-noirq, wrong-id, "
-                         "wrong-version, old-version")
+                    help="run only this boot (repeatable): full4, lean2-noirq, full4-engine, "
+                         "lean3-engine-noirq, wrong-id, wrong-version, old-version")
     args = ap.parse_args(argv)
     if args.jobs < 1:
         ap.error("--jobs must be at least 1")
@@ -84,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
                                 f"build/linux/boots/{b.name}/console.log)"))
         good = sum(r[0] for r in out.results)
         kernel.say(f"boot {b.name}: {good} passed, {len(out.results) - good} failed "
-                    f"({out.seconds:.1f} s)")
+                    f"({out.seconds:.1f} s; {out.answers})")
         results += [(ok, f"{b.name}: {what}") for ok, what in out.results]
     kernel.say("devicetree binding: dtschema")
     results += binding.check(tree, dtc, dts_files)

@@ -51,7 +51,7 @@ class SocConfig:
     snapshots: int = 100         # global snapshots the firmware records (one per ms)
     opt_level: str = "O3"        # C++ optimisation of the Verilated model
     efifo_log2: int = 0          # the edge FIFO of every channel: 2^efifo_log2 entries, 0 none
-    engine: int = 0              # 1: the channels share one engine (lean profile only)
+    engine: int = 0              # 1: the channels share one engine (CAPS.ENGINE = shared)
     motion_names: tuple = ()     # the channels' motions by name (motion.profiles); () all four
 
     @property
@@ -72,12 +72,14 @@ class SocConfig:
         return [base[k % len(base)] for k in range(self.channels)]
 
 
-# the builds `make soc-sim` runs: the 4 motions without an edge FIFO, and an edge-FIFO build whose
+# the builds `make soc-sim` runs: the 4 motions without an edge FIFO; an edge-FIFO build whose
 # firmware drains every channel's FIFO (without the steady channel's 3.1 million steps per
-# second, which no firmware on this CPU could drain: doc/litex.md)
+# second, which no firmware on this CPU could drain: doc/litex.md); the 4 motions on lean and on
+# full channels that share one engine
 MAIN = SocConfig()
 EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
 ENGINE = SocConfig(profile="lean", engine=1)
+ENGINE_FULL = SocConfig(profile="full", engine=1)
 
 
 def _log(msg: str) -> None:

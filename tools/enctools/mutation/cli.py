@@ -22,6 +22,7 @@ import argparse
 import itertools
 import os
 import queue
+import re
 import resource
 import shutil
 import signal
@@ -121,6 +122,9 @@ def parse_args(argv=None):
                     "mutate -list, on the one --only module at each of its corners; cell names "
                     "as in build/mutate/<work>/<module>_<corner>/orig.il")
     ap.add_argument("--no-results", action="store_true", help="do not write doc/results/mutation.md")
+    ap.add_argument("--table", default="mutation", metavar="NAME",
+                    help="write the table to doc/results/NAME.md (default mutation; a run of some "
+                    "modules only, e.g. --only with -n, into a table of its own)")
     ap.add_argument("--report", action="store_true",
                     help="run nothing: write the table of the last run (build/mutate/seed<S>/"
                     "results.json) again, with the reasons now in scripts/mutate_reviewed.txt")
@@ -142,7 +146,19 @@ def parse_args(argv=None):
         ap.error("--mutation needs exactly one module in --only")
     if args.mutation:
         args.no_results = True
+    if not re.fullmatch(r"[A-Za-z0-9_-]+", args.table):
+        ap.error(f"--table {args.table!r}: a file name (letters, digits, _ and -), no path")
     return args
+
+
+def command_of(args) -> str:
+    """The command line a table names (what reruns it)."""
+    if not (args.only or args.n or args.table != "mutation"):
+        return "make mutate"
+    parts = ["scripts/mutate.py"] + ([f"--only {','.join(args.only)}"] if args.only else []) + \
+        ([f"-n {args.n}"] if args.n else []) + \
+        ([f"--table {args.table}"] if args.table != "mutation" else [])
+    return " ".join(parts)
 
 
 def report_again(args) -> int:
@@ -157,7 +173,8 @@ def report_again(args) -> int:
     run["cpu"] = sum(r.get("cpu", 0) for r in runs)
     if len(runs) > 1:
         run["parts"] = runs
-    return report(modules, corners, mutants, args.seed, run, notes, not args.no_results)
+    return report(modules, corners, mutants, args.seed, run, notes, not args.no_results,
+                  args.table, command_of(args))
 
 
 def main(argv=None) -> int:
@@ -281,7 +298,8 @@ def main(argv=None) -> int:
            "jobs": args.jobs, "load": [round(x, 1) for x in load_start + os.getloadavg()],
            "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
     save_results(root, list(modules), corners, mutants, run, notes)
-    return report(list(modules), corners, mutants, args.seed, run, notes, not args.no_results)
+    return report(list(modules), corners, mutants, args.seed, run, notes, not args.no_results,
+                  args.table, command_of(args))
 
 
 if __name__ == "__main__":

@@ -101,7 +101,7 @@ def table_rows(modules, corners, mutants, reviewed) -> tuple[tuple, list[tuple]]
 
 
 def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
-           write_md: bool = True) -> int:
+           write_md: bool = True, table: str = "mutation", command: str = "make mutate") -> int:
     reviewed = load_reviewed()
     head, rows = table_rows(modules, corners, mutants, reviewed)
     table = [head] + rows
@@ -131,7 +131,8 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
         print(f"UNRESOLVED {m.mutant_id()} {m.corner.module} {m.corner.label}: {m.describe()} "
               f"in {m.failed_test}: {m.eq_note}")
     if write_md:
-        write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n)
+        write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n,
+                         RESULTS / f"{table}.md", command)
     status = 0
     if unreviewed:
         print(f"mutate: {len(unreviewed)} survivor(s) neither equivalent nor reviewed "
@@ -143,9 +144,10 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
     return status
 
 
-def write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n) -> None:
+def write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n,
+                     path: Path = RESULTS_MD, command: str = "make mutate") -> None:
     md = ["# Mutation coverage", "",
-          f"`make mutate` (scripts/mutate.py; how it works: [doc/mutation.md](../mutation.md)). "
+          f"`{command}` (scripts/mutate.py; how it works: [doc/mutation.md](../mutation.md)). "
           f"Seed {seed}, {n} mutants, {run['jobs']} jobs, {run['elapsed'] / 60:.1f} min wall time, "
           f"{run.get('cpu', 0) / 60:.1f} CPU-minutes (user + system of the tools it ran), "
           f"{load_txt}, {run.get('date', '')}.", "",
@@ -184,6 +186,6 @@ def write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt
         for m in loops:
             md.append(f"| {m.corner.module} | {m.corner.label} | {m.describe().replace('|', chr(92) + '|')} "
                       f"| {m.result} | {m.failed_test.replace('|', chr(92) + '|')} |")
-    RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS_MD.write_text("\n".join(md) + "\n")
-    print(f"table written to {RESULTS_MD.relative_to(TOP)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(md) + "\n")
+    print(f"table written to {path.relative_to(TOP)}")

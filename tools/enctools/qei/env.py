@@ -41,9 +41,12 @@ ENGINE_SHOW_COUNT = 24  # ... COUNT_LO / COUNT_HI: P + 24
 ENGINE_IRQ = 44         # irq and IRQ_SUMMARY rise and fall at most P + 44 later
 ENGINE_ACT = 18         # a write of a register the counting uses acts at most P + 18 after its request
 ENGINE_STATE_ACT = 26   # a write of EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN or COUNT_HI: P + 26
-ENGINE_WAIT = 40        # a read or a second write of a channel waits at most P + 40 for a write
-ENGINE_ANSWER = 4       # otherwise a channel register access is answered 4 clocks after its request
-PER_CHANNEL_ANSWER = 2  # ... 2 on a per-channel build
+ENGINE_WAIT = 66        # a read right after a write of its channel is answered at most P + 66 after the write's request
+ENGINE_STATE_WAIT = 30  # ... after a state write (EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN, COUNT_HI): P + 30
+ENGINE_ANSWER = 4       # otherwise a channel register write is answered 4 clocks after its request
+ENGINE_READ_ANSWER = 5  # ... a read 5
+ENGINE_PART_ANSWER = 6  # ... a COUNT_LO write with some but not all byte enables 6
+PER_CHANNEL_ANSWER = 2  # ... 2 on a per-channel build (reads and writes)
 
 
 def engine_period(channels: int) -> int:
@@ -161,6 +164,9 @@ class Env:
         model.set_func(func, QUAD[self.pos % 4])
         await bus.set_count(count)
         model.write_count(count)
+        # (the shared engine: the load acts within P + 14 of the write's answer, and an event it
+        # raises, CMP, shows within P + 44 after that; then the events are cleared)
+        await self.applied()
         await self.settle()
         await bus.events()
         await bus.wr("QERR_COUNT", 0)

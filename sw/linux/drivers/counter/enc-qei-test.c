@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-2.0
 /*
  * KUnit tests of the enc-qei driver's decisions: the ID it accepts, how it
- * reads CAPS, the count functions, Synapse actions and events it maps, and
- * the spike filter conversion. Built into enc-qei.c when
- * CONFIG_ENC_QEI_KUNIT_TEST is set; the tests run when the module loads.
+ * reads CAPS, the count functions, Synapse actions and events it maps, the
+ * spike filter conversion and the snapshot's wait on the shared engine.
+ * Built into enc-qei.c when CONFIG_ENC_QEI_KUNIT_TEST is set; the tests run
+ * when the module loads.
  */
 #include <kunit/test.h>
 
@@ -41,6 +42,12 @@ static void enc_qei_test_parse_caps(struct kunit *test)
 	KUNIT_EXPECT_EQ(test, caps.ts_w, 32U);
 	KUNIT_EXPECT_TRUE(test, caps.has_range);
 	KUNIT_EXPECT_TRUE(test, caps.has_timing);
+	KUNIT_EXPECT_FALSE(test, caps.engine);
+
+	KUNIT_ASSERT_EQ(test, enc_qei_parse_caps(enc_qei_test_caps_word(4, 2, 1, 32, 32) |
+						 ENC_QEI_CAPS_ENGINE, &caps), 0);
+	KUNIT_EXPECT_EQ(test, caps.channels, 4U);
+	KUNIT_EXPECT_TRUE(test, caps.engine);
 
 	KUNIT_ASSERT_EQ(test, enc_qei_parse_caps(enc_qei_test_caps_word(16, 3, 1, 16, 64),
 						 &caps), 0);
@@ -175,6 +182,25 @@ static void enc_qei_test_spike_filter(struct kunit *test)
 	KUNIT_EXPECT_EQ(test, enc_qei_filter_len(U64_MAX, 100000000, &len), -EINVAL);
 }
 
+static void enc_qei_test_snapshot_ticks(struct kunit *test)
+{
+	struct enc_qei_caps caps = { .channels = 4, .engine = false };
+
+	/* per_channel: the snapshot reads at once */
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 0), 0U);
+	/* shared engine: 2P + 48 clocks, P = 24 * max(CHANNELS, 2), and a tick */
+	caps.engine = true;
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 0), 2 * 96 + 48 + 1U);
+	caps.channels = 1;
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 0), 2 * 48 + 48 + 1U);
+	caps.channels = 16;
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 0), 2 * 384 + 48 + 1U);
+	/* ticks of PRESCALE + 1 clocks, rounded up */
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 1), 408 + 1U);
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 6), 117 + 1U);
+	KUNIT_EXPECT_EQ(test, enc_qei_snapshot_ticks(&caps, 0xffff), 1 + 1U);
+}
+
 static struct kunit_case enc_qei_test_cases[] = {
 	KUNIT_CASE(enc_qei_test_check_id),
 	KUNIT_CASE(enc_qei_test_parse_caps),
@@ -182,6 +208,7 @@ static struct kunit_case enc_qei_test_cases[] = {
 	KUNIT_CASE(enc_qei_test_actions),
 	KUNIT_CASE(enc_qei_test_events),
 	KUNIT_CASE(enc_qei_test_spike_filter),
+	KUNIT_CASE(enc_qei_test_snapshot_ticks),
 	{ }
 };
 

@@ -16,6 +16,7 @@
 #include <linux/counter.h>
 #include <linux/interrupt.h>
 #include <linux/io.h>
+#include <linux/iopoll.h>
 #include <linux/kernel.h>
 #include <linux/math64.h>
 #include <linux/mod_devicetable.h>
@@ -65,6 +66,7 @@
 #define ENC_QEI_CAPS_TIMING		BIT(18)
 #define ENC_QEI_CAPS_PROFILE		GENMASK(21, 19)
 #define ENC_QEI_CAPS_CHANNELS		GENMASK(26, 22)
+#define ENC_QEI_CAPS_ENGINE		BIT(31)
 #define ENC_QEI_PROFILE_COUNTING	1
 #define ENC_QEI_PROFILE_FULL		2
 #define ENC_QEI_PROFILE_LEAN		3
@@ -118,7 +120,14 @@
 #define ENC_QEI_EV_SNAP_READY		BIT(9)
 #define ENC_QEI_EV_ALL			GENMASK(13, 0)
 
+#define ENC_QEI_TB_PRESCALE_PRESCALE	GENMASK(15, 0)
 #define ENC_QEI_GSNAP_CTRL_CMD		BIT(0)
+
+/* The shared engine visits each channel in 24 clocks, at least two visits */
+#define ENC_QEI_ENGINE_VISIT_CLOCKS	24
+#define ENC_QEI_ENGINE_MIN_VISITS	2U
+/* Give up on a snapshot the timebase does not time (broken hardware) */
+#define ENC_QEI_SNAPSHOT_TIMEOUT_US	USEC_PER_SEC
 
 /* Signals of channel k: 3k + ENC_QEI_SIGNAL_x */
 enum enc_qei_signal {
@@ -136,6 +145,8 @@ enum enc_qei_signal {
  * @profile:	CAPS.PROFILE
  * @has_range:	CEILING, COMPARE and CTRL.RANGE are built (not lean)
  * @has_timing:	timebase, snapshots and the global snapshot are built
+ * @engine:	CAPS.ENGINE: the channels share one engine, which shows
+ *		changes and lets writes act later, by bounds in clocks
  */
 struct enc_qei_caps {
 	unsigned int channels;
@@ -144,6 +155,7 @@ struct enc_qei_caps {
 	unsigned int profile;
 	bool has_range;
 	bool has_timing;
+	bool engine;
 };
 
 /**
@@ -202,6 +214,7 @@ static int enc_qei_parse_caps(u32 word, struct enc_qei_caps *caps)
 	caps->ts_w = FIELD_GET(ENC_QEI_CAPS_TS_W, word);
 	caps->profile = FIELD_GET(ENC_QEI_CAPS_PROFILE, word);
 	caps->has_timing = word & ENC_QEI_CAPS_TIMING;
+	caps->engine = word & ENC_QEI_CAPS_ENGINE;
 	caps->has_range = caps->profile == ENC_QEI_PROFILE_FULL ||
 			  caps->profile == ENC_QEI_PROFILE_COUNTING;
 
@@ -289,6 +302,27 @@ static u32 enc_qei_event_bits(u8 event, const struct enc_qei_caps *caps)
 	default:
 		return 0;
 	}
+}
+
+/*
+ * Timebase ticks from a global snapshot command until every channel's
+ * SNAP_* registers read it: none beyond the next read on a per_channel
+ * build. The shared engine (CAPS.ENGINE) takes the snapshot in the
+ * command's snapshot clock (its request + 3) or up to P clocks later, while
+ * a channel's capture waits, and shows it P + 44 clocks after the clock a
+ * per_channel build shows it in, P = 24 * max(CHANNELS, 2) (the bounds of
+ * rtl/enc_qei.rdl): 2P + 48 clocks from the command's request. One tick
+ * more covers the prescaler's phase and the reads' own clocks.
+ */
+static u32 enc_qei_snapshot_ticks(const struct enc_qei_caps *caps,
+				  u32 prescale)
+{
+	u32 p = ENC_QEI_ENGINE_VISIT_CLOCKS *
+		max(caps->channels, ENC_QEI_ENGINE_MIN_VISITS);
+
+	if (!caps->engine)
+		return 0;
+	return DIV_ROUND_UP(2 * p + 48, prescale + 1) + 1;
 }
 
 /* Pulses up to (FILTER_LEN - 1) clock periods are rejected */
@@ -846,12 +880,32 @@ static int enc_qei_snapshot_read(struct counter_device *counter, u8 *val)
 	return 0;
 }
 
+/*
+ * A global snapshot; the write returns once every channel's snapshot_count
+ * reads it. The shared engine shows it later than the next read (see
+ * enc_qei_snapshot_ticks()): the timebase times the wait, so the wait
+ * follows the peripheral's clock, however slow the bus between.
+ */
 static int enc_qei_snapshot_write(struct counter_device *counter, u8 val)
 {
-	if (val)
-		enc_qei_update(counter_priv(counter), 0, ENC_QEI_GSNAP_CTRL,
-			       ENC_QEI_GSNAP_CTRL_CMD, ENC_QEI_GSNAP_CTRL_CMD);
-	return 0;
+	struct enc_qei_priv *priv = counter_priv(counter);
+	u32 mask = GENMASK(priv->caps.ts_w - 1, 0);
+	u32 ticks, t0, t;
+
+	if (!val)
+		return 0;
+	ticks = enc_qei_snapshot_ticks(&priv->caps,
+				       FIELD_GET(ENC_QEI_TB_PRESCALE_PRESCALE,
+						 enc_qei_read(priv, 0,
+							      ENC_QEI_TB_PRESCALE)));
+	t0 = enc_qei_read(priv, 0, ENC_QEI_TIMEBASE);
+	enc_qei_update(priv, 0, ENC_QEI_GSNAP_CTRL, ENC_QEI_GSNAP_CTRL_CMD,
+		       ENC_QEI_GSNAP_CTRL_CMD);
+	if (!ticks)
+		return 0;
+	return readl_poll_timeout(priv->base + ENC_QEI_TIMEBASE, t,
+				  ((t - t0) & mask) >= ticks, 0,
+				  ENC_QEI_SNAPSHOT_TIMEOUT_US);
 }
 
 static int enc_qei_snapshot_time_read(struct counter_device *counter,
@@ -871,7 +925,8 @@ static int enc_qei_timebase_frequency_read(struct counter_device *counter,
 					   u64 *val)
 {
 	struct enc_qei_priv *priv = counter_priv(counter);
-	u32 prescale = enc_qei_read(priv, 0, ENC_QEI_TB_PRESCALE) & 0xffff;
+	u32 prescale = FIELD_GET(ENC_QEI_TB_PRESCALE_PRESCALE,
+				 enc_qei_read(priv, 0, ENC_QEI_TB_PRESCALE));
 
 	*val = div_u64(priv->clk_rate, prescale + 1);
 	return 0;
@@ -1186,11 +1241,12 @@ static int enc_qei_probe(struct platform_device *pdev)
 	if (ret)
 		return dev_err_probe(dev, ret, "failed to add counter\n");
 
-	dev_info(dev, "%u channels, %u-bit counts, %s profile%s\n",
+	dev_info(dev, "%u channels, %u-bit counts, %s profile%s%s\n",
 		 priv->caps.channels, priv->caps.count_w,
 		 priv->caps.profile == ENC_QEI_PROFILE_LEAN ? "lean" :
 		 priv->caps.profile == ENC_QEI_PROFILE_FULL ? "full" :
-		 "counting", priv->has_irq ? "" : ", no interrupt: no events");
+		 "counting", priv->caps.engine ? ", shared engine" : "",
+		 priv->has_irq ? "" : ", no interrupt: no events");
 	return 0;
 }
 

@@ -1,0 +1,240 @@
+// SPDX-License-Identifier: Apache-2.0
+// Formal wrapper for enc_qei_engine, the shared channel engine (read by formal/enc_qei_engine.sby;
+// `make formal`): its schedule and the discipline of its two memories.
+//
+// Every input is free after the first-clock reset (rst too): the encoder pins, snap_in, the
+// timebase and its tick, the global snapshot's request, and channel-page requests of any
+// register, data and byte enables to any built channel, one at a time (enc_qei's port: a request
+// only while none is unanswered, or in the clock of the answer). The lanes are cut out (the .sby's
+// `cutpoint enc_qei_lane`): their records and snap_pend are free at every clock, so nothing below
+// depends on what a lane counts (formal/enc_qei_lane.sby checks the lane).
+// Proven (k-induction), through probes the .sby connects after flatten:
+//   - the visit order: slot 0 .. 23, c(v + 1) follows c(v) and c(v - 1) precedes it, modulo
+//     CH_EFF = max(CHANNELS, 2);
+//   - every lane is read (rd, one-hot or none) exactly every P = 24 * CH_EFF clocks, the first
+//     time within P clocks of rst: a per-lane count of the clocks since its last read (or rst)
+//     never exceeds P and is P at every read but the first;
+//   - the push: a lane's configuration is pushed (cfg_we) in the clock before each of its reads
+//     and at no other time but the clock before that, which only a COUNT write's value uses, and
+//     then ld comes with the push after it (the value a clock ahead of its load);
+//   - the state memory's port a never reads, in a slot whose data the engine uses (1 .. 22), the
+//     word written in that clock (enc_qei_ram has no read-during-write bypass); the port-b data
+//     the bus takes (the first of its two reads, or the second when the first met a write of
+//     its word: b_clash) was not read in a clock that wrote that word; the write slots' memory
+//     (u_pend) is never read for a taken write in the clock it is written, on either port;
+//   - a bus write is taken once and applied once: per channel, a write waits (pend) or is being
+//     applied (busy), never both; the bus posts a write only into a free slot of a channel with no
+//     write unapplied; the engine takes only a waiting write and completes only a taken one; a
+//     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
+//     minus completed writes is pend | busy).
+`default_nettype none
+
+module enc_qei_engine_formal #(
+    parameter integer CHANNELS = 2,   // the engine's channels
+    parameter integer COUNT_W  = 16,  // the count's width
+    parameter integer TS_W     = 16   // the timebase's width
+) (
+    input wire                clk,
+    input wire                rst,
+    input wire                req_valid,
+    input wire                req_write,
+    input wire [3:0]          req_ch,
+    input wire [5:0]          req_word,
+    input wire [31:0]         req_wdata,
+    input wire [3:0]          req_wstrb,
+    input wire [CHANNELS-1:0] a_in,
+    input wire [CHANNELS-1:0] b_in,
+    input wire [CHANNELS-1:0] z_in,
+    input wire [CHANNELS-1:0] probe_in,
+    input wire                snap_in,
+    input wire [TS_W-1:0]     timebase,
+    input wire                tick,
+    input wire                gsnap_req
+);
+
+  localparam integer CH_EFF = (CHANNELS < 2) ? 2 : CHANNELS;
+  localparam integer V      = 24;
+  localparam integer P      = V * CH_EFF;
+  localparam integer AW     = 9;  // the state memory's address bits (enc_qei_engine: CH_W + 5)
+
+  wire                resp_valid, gsnap;
+  wire [31:0]         resp_rdata;
+  wire [CHANNELS-1:0] irq_pend, cmp_out;
+
+  enc_qei_engine #(
+      .CHANNELS(CHANNELS),
+      .COUNT_W (COUNT_W),
+      .TS_W    (TS_W),
+      .TIMING  (1),
+      .RANGE   (1),
+      .PROBE   (1),
+      .PERIOD  (1)
+  ) eng (
+      .clk       (clk),
+      .rst       (rst),
+      .req_valid (req_valid),
+      .req_write (req_write),
+      .req_ch    (req_ch),
+      .req_word  (req_word),
+      .req_wdata (req_wdata),
+      .req_wstrb (req_wstrb),
+      .resp_valid(resp_valid),
+      .resp_rdata(resp_rdata),
+      .a_in      (a_in),
+      .b_in      (b_in),
+      .z_in      (z_in),
+      .probe_in  (probe_in),
+      .snap_in   (snap_in),
+      .timebase  (timebase),
+      .tick      (tick),
+      .gsnap_req (gsnap_req),
+      .gsnap     (gsnap),
+      .irq_pend  (irq_pend),
+      .cmp_out   (cmp_out)
+  );
+
+  // ---- probes, connected by the .sby after flatten ------------------------------------------------
+  (* keep *) wire [4:0]          p_slot;      // eng.slot_q
+  (* keep *) wire [3:0]          p_cp;        // eng.cp_q: c(v)
+  (* keep *) wire [3:0]          p_cn;        // eng.cn_q: c(v + 1)
+  (* keep *) wire [3:0]          p_cw;        // eng.cw_q: c(v - 1)
+  (* keep *) wire [CHANNELS-1:0] p_rd;        // eng.rd_q
+  (* keep *) wire [CHANNELS-1:0] p_cfg_we;    // eng.cfg_we_q
+  (* keep *) wire                p_ld;        // eng.ld_q
+  (* keep *) wire                p_we;        // eng.we: the state memory's write
+  (* keep *) wire [AW-1:0]       p_waddr;     // eng.waddr
+  (* keep *) wire [AW-1:0]       p_raddr_a;   // eng.raddr_a
+  (* keep *) wire [AW-1:0]       p_raddr_b;   // eng.raddr_b
+  (* keep *) wire [2:0]          p_b_st;      // eng.b_st_q
+  (* keep *) wire [3:0]          p_b_ch;      // eng.b_ch_q: the request's channel
+  (* keep *) wire                p_b_take;    // eng.b_take: the bus takes port b's data now
+  (* keep *) wire [CHANNELS-1:0] p_pend;      // eng.pend_q
+  (* keep *) wire [CHANNELS-1:0] p_busy;      // eng.busy_q
+  (* keep *) wire [CHANNELS-1:0] p_pend_st;   // eng.pend_st_q
+  (* keep *) wire [CHANNELS-1:0] p_pend_set;  // eng.pend_set
+  (* keep *) wire [CHANNELS-1:0] p_take;      // eng.take_oh
+  (* keep *) wire [CHANNELS-1:0] p_done;      // eng.done_oh
+  (* keep *) wire                p_n_taken;   // eng.n_taken: c(v + 1)'s write taken (slot 9)
+  (* keep *) wire                p_p_taken;   // eng.p_taken: c(v)'s, taken in the visit before
+  (* keep *) wire                p_e_taken;   // eng.e_taken: c(v)'s state write taken (slot 21)
+  (* keep *) wire                p_w_taken;   // eng.w_taken_q: c(v - 1)'s write is applied
+  (* keep *) wire                p_wr_on;     // eng.wr_on_q: results are written
+  (* keep *) wire                p_pend_we;   // eng.pend_we: the write slots' write
+  (* keep *) wire [3:0]          p_pend_wch;  // eng.pend_wch
+
+  localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_RD1 = 3'd2, B_RD2 = 3'd3, B_POST = 3'd4,
+                   B_DONE = 3'd5;
+
+  // ---- the port's rules ---------------------------------------------------------------------------
+  reg f_past = 1'b0;
+  reg f_out_q;  // a request is unanswered
+  always @(posedge clk) f_past <= 1'b1;
+
+  always @(posedge clk) begin
+    if (rst) f_out_q <= 1'b0;
+    else if (req_valid) f_out_q <= 1'b1;
+    else if (resp_valid) f_out_q <= 1'b0;
+  end
+
+  always @(*) begin
+    if (!f_past) assume (rst);
+    if (req_valid) assume (req_ch < CHANNELS && (!f_out_q || resp_valid));
+  end
+
+  // ---- the schedule's reference ---------------------------------------------------------------------
+  function [3:0] nxt;  // c + 1 mod CH_EFF
+    input [3:0] c;
+    begin
+      nxt = (c == CH_EFF - 1) ? 4'd0 : c + 4'd1;
+    end
+  endfunction
+
+  function [3:0] dist;  // (a - b) mod CH_EFF, a and b < CH_EFF
+    input [3:0] a;
+    input [3:0] b;
+    begin
+      dist = (a >= b) ? a - b : a + CH_EFF[3:0] - b;
+    end
+  endfunction
+
+  // per lane: clocks since its last read (or rst), and whether it was read since rst
+  reg [7:0]          f_cnt [0:CHANNELS-1];
+  reg [CHANNELS-1:0] f_seen;
+  reg [CHANNELS-1:0] f_cfg_we1;  // cfg_we the clock before
+  reg                f_wclash_b; // a write to the word port b read in that clock
+  reg                f_took1;    // the bus took port b's first read
+  // per channel: writes posted and not completed (the wrapper's count)
+  reg [1:0]          f_owed [0:CHANNELS-1];
+  integer            k;
+
+  always @(posedge clk) begin
+    f_cfg_we1  <= rst ? {CHANNELS{1'b0}} : p_cfg_we;
+    f_wclash_b <= p_we & (p_waddr == p_raddr_b);
+    f_took1    <= (p_b_st == B_RD1) & p_b_take;
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      if (rst) begin
+        f_cnt[k]  <= 8'd0;
+        f_seen[k] <= 1'b0;
+        f_owed[k] <= 2'd0;
+      end else begin
+        f_cnt[k]  <= p_rd[k] ? 8'd1 : (f_cnt[k] == 8'hFF) ? f_cnt[k] : f_cnt[k] + 8'd1;
+        f_seen[k] <= f_seen[k] | p_rd[k];
+        f_owed[k] <= f_owed[k] + {1'b0, p_pend_set[k]} - {1'b0, p_done[k]};
+      end
+    end
+  end
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      // the visit order
+      assert (p_slot < V && p_cp < CH_EFF && p_cn == nxt(p_cp) && nxt(p_cw) == p_cp);
+      for (k = 0; k < CHANNELS; k = k + 1) begin
+        // the reads: in slot 23 of the visit before the lane's (c(v + 1) = k), every P clocks
+        assert (p_rd[k] == (p_slot == V - 1 && p_cn == k));
+        assert (f_cnt[k] <= P);
+        if (p_rd[k] && f_seen[k]) assert (f_cnt[k] == P);
+        if (f_seen[k]) assert (f_cnt[k] == V * dist(p_cn, nxt(k)) + p_slot + 1);
+        else assert (f_cnt[k] == V * dist(p_cn, 4'd1) + p_slot && dist(p_cn, 4'd1) <= dist(k, 4'd1));
+        // the push: in the clock before each read, or (a COUNT write's value) the one before it
+        assert (p_cfg_we[k] == (p_cn == k && (p_slot == V - 2 || (p_slot == V - 3 && p_cfg_we[k]))));
+        if (p_slot == V - 2 && p_cn == k) assert (p_ld == f_cfg_we1[k]);
+        // a write: waiting or being applied, never both; the count of unapplied writes
+        assert (!(p_pend[k] && p_busy[k]));
+        assert (f_owed[k] == {1'b0, p_pend[k] | p_busy[k]});
+        if (p_pend_set[k]) assert (!p_pend[k] && !p_busy[k]);
+        if (p_take[k]) assert (p_pend[k]);
+        if (p_done[k]) assert (p_busy[k]);
+        // (where a taken write is: taken for c(v + 1) in slot 9, its push; c(v)'s visit, where a
+        // state write is taken in slot 21; written back in c(v - 1)'s slots 0 .. 19)
+        assert (p_busy[k] == ((p_cw == k && p_wr_on && p_slot <= 5'd19 && p_w_taken) ||
+                              (p_cn == k && p_slot >= 5'd10 && p_n_taken) ||
+                              (p_cp == k && (p_p_taken || (p_slot >= 5'd22 && p_e_taken)))));
+      end
+      if (p_slot != V - 2) assert (!p_ld);
+      if (p_slot <= 5'd9) assert (p_n_taken == p_p_taken);
+      // (one write per channel in flight: c(v - 1) = c(v + 1) with two channels)
+      if (p_slot >= 5'd10 && p_slot <= 5'd19 && p_cw == p_cn && p_wr_on) assert (!(p_w_taken && p_n_taken));
+      if (p_slot >= 5'd22) assert (!(p_p_taken && p_e_taken));
+      // (the bus: a write on its way to its slot found the channel with no write unapplied)
+      assert (p_b_st <= B_DONE && (p_b_st == B_IDLE || p_b_ch < CHANNELS));
+      if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST)
+        assert (!(|((p_pend | p_busy) & (1 << p_b_ch))));
+      assert (p_pend_set == ((p_b_st == B_DONE && p_pend_we) ? (1 << p_b_ch) : 0));
+      if (p_pend_we) assert (p_b_st == B_DONE && p_pend_wch == p_b_ch);
+      // port a: a read whose data is used (slots 1 .. 22) is not of the word written in its clock
+      if (p_slot >= 1 && p_slot <= V - 2) assert (!(p_we && p_waddr == p_raddr_a));
+      // port b: the data the bus takes (B_RD1's, or B_RD2's after a clash) was not read in a
+      // write's clock to that word; it takes one of its two reads, exactly one
+      if (p_b_take) assert (!f_wclash_b && (p_b_st == B_RD1 || p_b_st == B_RD2));
+      if (p_b_st == B_RD2) assert (p_b_take != f_took1);
+      // the write slots: a taken write's word is not written in the clock it is read
+      if (p_slot == 5'd9 && (|(p_pend & ~p_pend_st & (1 << p_cn))))
+        assert (!(p_pend_we && p_pend_wch == p_cn));
+      if (p_slot == 5'd21 && (|(p_pend & p_pend_st & (1 << p_cp))))
+        assert (!(p_pend_we && p_pend_wch == p_cp));
+    end
+  end
+
+endmodule
+
+`default_nettype wire

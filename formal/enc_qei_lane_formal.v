@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: Apache-2.0
+// Formal wrapper for enc_qei_lane, the shared engine's per-channel lane (read by
+// formal/enc_qei_lane.sby; `make formal`): its accumulators are wide enough for the engine's
+// schedule, so no step, error, rejected level or tick is lost between two reads.
+//
+// The wrapper plays the engine (rtl/enc_qei_engine.v) towards one lane, with the engine's widths
+// for CHANNELS (P = 24 * max(CHANNELS, 2), MOT_W, TIM_W, ERR_W as enc_qei_engine sizes them): it
+// reads the lane (rd) every L clocks, L free in 2 .. P for every window (the engine reads every P
+// clocks exactly: formal/enc_qei_engine.sby proves that), pushes any configuration in the clock
+// before each read (and may push one in the clock before that, as a COUNT write's value does),
+// with ld, arm_we, pen_we and snap_cmd free at the push. Free at every clock: rst (the first clock
+// is a reset), valid, the pins, snap_in, the timebase's tick, snap_hold, gsnap (raised only when
+// the lane has no capture waiting, or in the clock of its read: the engine's rule).
+// From each record the wrapper rebuilds what the engine rebuilds, with the engine's formulas:
+// the motion M += the signed difference of mpos and its value at the read before; the error and
+// glitch counts += the difference of qcnt / gcnt (mod 2^ERR_W); a timestamp = the timebase at the
+// read - (its low bits at the read - the TIM_W bits kept), mod 2^16; a snapshot's motion = M at
+// the read before + the signed difference of smpos and mpos then.
+// Proven (k-induction) at every read, against the wrapper's wide counts of the lane's own decode
+// (step_up / step_dn, qerr) and filters (glitch_q), and its own timebase: M equals the steps
+// counted (each +1 / -1), the error and glitch counts equal the errors and rejected levels
+// counted; a snapshot waiting at the read has the timebase and the motion of its clock, a probe
+// latch the timebase of its clock. With three bits less of MOT_W or two of ERR_W (the wrapper's
+// MOT_CUT / ERR_CUT, deliberate breaks) it fails; with two and one it passes (MOT_W is sized for
+// the reach of lo, not for the motion).
+// Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
+// formal/README.md: that comparison did not finish within the time a task may take).
+`default_nettype none
+
+module enc_qei_lane_formal #(
+    parameter integer CHANNELS = 2,   // the engine's channels: P and the widths from them
+    parameter integer MOT_CUT  = 0,   // bits taken off MOT_W (a deliberate break)
+    parameter integer ERR_CUT  = 0    // bits taken off ERR_W (a deliberate break)
+) (
+    input wire clk,
+    input wire rst,
+    input wire valid,
+    input wire a_in,
+    input wire b_in,
+    input wire z_in,
+    input wire probe_in,
+    input wire snap_in,
+    input wire tick,
+    input wire gsnap,
+    input wire snap_hold
+);
+
+  // ---- the engine's widths (rtl/enc_qei_engine.v) ---------------------------------------------
+  function integer clog2;
+    input integer v;
+    integer       n;
+    begin
+      clog2 = 0;
+      for (n = 1; n < v; n = n * 2) begin
+        clog2 = clog2 + 1;
+      end
+    end
+  endfunction
+
+  localparam integer CH_EFF = (CHANNELS < 2) ? 2 : CHANNELS;
+  localparam integer P      = 24 * CH_EFF;
+  localparam integer REACH  = 2 * P + 4;
+  localparam integer MOT_W  = clog2(2 * REACH + 1) + 1 - MOT_CUT;
+  localparam integer TIM_W  = clog2(2 * P + 64);
+  localparam integer ERR_W  = clog2(P + 2) + 1 - ERR_CUT;
+  `include "enc_qei_lane.vh"
+
+  localparam integer WW = 16;  // the wrapper's wide counts
+
+  // ---- the schedule: windows, pushes and reads -------------------------------------------------
+  reg f_past = 1'b0;
+  always @(posedge clk) f_past <= 1'b1;
+  always @(*) if (!f_past) assume (rst);
+
+  (* anyseq *) reg [9:0]       len_in;   // the next window's length
+  (* anyseq *) reg [CFG_W-1:0] cfg_in;   // a configuration pushed
+  (* anyseq *) reg             push1_in, ld_in, arm_in, pen_in, scmd_in;
+  always @(*) assume (len_in >= 10'd2 && len_in <= P);
+
+  reg  [9:0] cd_q;  // clocks to the next read (0: read in this clock)
+  reg  [9:0] el_q;  // clocks since the last read (or rst)
+  wire       rd    = ~rst & (cd_q == 10'd0);
+  wire       push  = ~rst & (cd_q == 10'd1);
+  wire       push1 = ~rst & (cd_q == 10'd2) & push1_in;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      cd_q <= len_in - 10'd1;
+      el_q <= 10'd1;
+    end else begin
+      cd_q <= rd ? len_in - 10'd1 : cd_q - 10'd1;
+      el_q <= rd ? 10'd1 : el_q + 10'd1;
+    end
+  end
+
+  // ---- the lane -----------------------------------------------------------------------------------
+  reg  [WW-1:0]    f_tb;   // the timebase (TS_W bits kept: the wrapper's)
+  wire [REC_W-1:0] rec;
+  wire             snap_pend, cmp_out;
+
+  always @(posedge clk) begin
+    if (!f_past) f_tb <= {WW{1'b0}};
+    else if (tick) f_tb <= f_tb + {{(WW-1){1'b0}}, 1'b1};
+  end
+
+  enc_qei_lane #(
+      .MOT_W (MOT_W),
+      .TIM_W (TIM_W),
+      .ERR_W (ERR_W),
+      .TIMING(1),
+      .RANGE (1),
+      .PROBE (1),
+      .PERIOD(0)
+  ) lane (
+      .clk      (clk),
+      .rst      (rst),
+      .valid    (valid),
+      .a_in     (a_in),
+      .b_in     (b_in),
+      .z_in     (z_in),
+      .probe_in (probe_in),
+      .snap_in  (snap_in),
+      .tb_lo    (f_tb[TIM_W-1:0]),
+      .tick     (tick),
+      .gsnap    (gsnap),
+      .snap_hold(snap_hold),
+      .cfg_we   (push | push1),
+      .arm_we   (push & arm_in),
+      .pen_we   (push & pen_in),
+      .st_we    (1'b0),
+      .u_we     (1'b0),
+      .cfg      (cfg_in),
+      .ld       (push & ld_in),
+      .snap_cmd (push & scmd_in),
+      .rd       (rd),
+      .rec      (rec),
+      .snap_pend(snap_pend),
+      .cmp_out  (cmp_out)
+  );
+
+  // the engine raises gsnap only when the lane has no capture waiting, or in its read's clock
+  always @(*) if (gsnap) assume (!snap_pend || rd);
+
+  // ---- probes into the lane, connected by the .sby after flatten ---------------------------------
+  (* keep *) wire             p_up;      // lane.step_up: a step of the count function (EN on)
+  (* keep *) wire             p_dn;      // lane.step_dn
+  (* keep *) wire             p_qerr;    // lane.qerr: a quadrature error
+  (* keep *) wire             p_glitch;  // lane.glitch_q: a rejected level
+  (* keep *) wire             p_take;    // lane.g_snap.take: a snapshot taken in this clock
+  (* keep *) wire             p_phit;    // lane.g_probe.phit_q: a probe latch in this clock
+  (* keep *) wire [MOT_W-1:0] p_mpos;    // lane.mpos_q
+  (* keep *) wire [ERR_W-1:0] p_qcnt;    // lane.qcnt_q
+  (* keep *) wire [ERR_W-1:0] p_gcnt;    // lane.gcnt_q
+  (* keep *) wire             p_spend;   // lane.g_snap.spend_q
+  (* keep *) wire             p_ppend;   // lane.g_probe.ppend_q
+  (* keep *) wire [MOT_W-1:0] p_smpos;   // lane.g_snap.smpos_q
+  (* keep *) wire [TIM_W-1:0] p_stime;   // lane.g_snap.stime_q
+  (* keep *) wire [TIM_W-1:0] p_ptime;   // lane.g_probe.ptime_q
+
+  // ---- the wrapper's wide counts (as the lane's registers take them) ------------------------------
+  reg [WW-1:0] f_m, f_q, f_g;       // steps (+1 / -1), errors, rejected levels
+  reg [WW-1:0] f_sm, f_st, f_pt;    // a snapshot's motion and timebase, a probe latch's timebase
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_m <= {WW{1'b0}};
+      f_q <= {WW{1'b0}};
+      f_g <= {WW{1'b0}};
+    end else begin
+      f_m <= f_m + (p_dn ? {WW{1'b1}} : {{(WW-1){1'b0}}, p_up});
+      f_q <= f_q + {{(WW-1){1'b0}}, p_qerr};
+      f_g <= f_g + {{(WW-1){1'b0}}, p_glitch};
+    end
+    if (p_take) begin
+      f_sm <= f_m;
+      f_st <= f_tb;
+    end
+    if (p_phit) f_pt <= f_tb;
+  end
+
+  // ---- the engine's view: what it rebuilds at each read -------------------------------------------
+  function [WW-1:0] sdiff;  // a - b, MOT_W bits, sign-extended
+    input [MOT_W-1:0] a;
+    input [MOT_W-1:0] b;
+    reg   [MOT_W-1:0] d;
+    begin
+      d     = a - b;
+      sdiff = {{(WW - MOT_W){d[MOT_W-1]}}, d};
+    end
+  endfunction
+
+  function [WW-1:0] tstamp;  // a timestamp from its low bits, at the timebase now
+    input [TIM_W-1:0] t;
+    input [WW-1:0]    now;
+    reg   [TIM_W-1:0] age;
+    begin
+      age    = now[TIM_W-1:0] - t;
+      tstamp = now - {{(WW - TIM_W){1'b0}}, age};
+    end
+  endfunction
+
+  wire [MOT_W-1:0] x_mpos  = rec[R_MPOS +: R_MPOS_W];
+  wire [MOT_W-1:0] x_smpos = rec[R_SMPOS +: R_SMPOS_W];
+  wire [ERR_W-1:0] x_qcnt  = rec[R_QCNT +: R_QCNT_W];
+  wire [ERR_W-1:0] x_gcnt  = rec[R_GCNT +: R_GCNT_W];
+  wire [TIM_W-1:0] x_stime = rec[R_STIME +: R_STIME_W];
+  wire [TIM_W-1:0] x_ptime = rec[R_PTIME +: R_PTIME_W];
+
+  reg  [WW-1:0]    e_m, e_q, e_g;  // M, the error and glitch counts, as of the last read
+  reg  [MOT_W-1:0] e_mb;           // mpos at the last read
+  reg  [ERR_W-1:0] e_qb, e_gb;     // qcnt, gcnt at the last read
+  wire [WW-1:0]    e_m_n = e_m + sdiff(x_mpos, e_mb);
+  wire [WW-1:0]    e_q_n = e_q + {{(WW - ERR_W){1'b0}}, x_qcnt - e_qb};
+  wire [WW-1:0]    e_g_n = e_g + {{(WW - ERR_W){1'b0}}, x_gcnt - e_gb};
+
+  always @(posedge clk) begin
+    if (rst) begin
+      e_m  <= {WW{1'b0}};
+      e_q  <= {WW{1'b0}};
+      e_g  <= {WW{1'b0}};
+      e_mb <= {MOT_W{1'b0}};
+      e_qb <= {ERR_W{1'b0}};
+      e_gb <= {ERR_W{1'b0}};
+    end else if (rd) begin
+      e_m  <= e_m_n;
+      e_q  <= e_q_n;
+      e_g  <= e_g_n;
+      e_mb <= x_mpos;
+      e_qb <= x_qcnt;
+      e_gb <= x_gcnt;
+    end
+  end
+
+  // distance of two wide counts
+  function [WW-1:0] wdist;
+    input [WW-1:0] a;
+    input [WW-1:0] b;
+    reg   [WW-1:0] d;
+    begin
+      d     = a - b;
+      wdist = d[WW-1] ? {WW{1'b0}} - d : d;
+    end
+  endfunction
+
+  // ---- the properties -----------------------------------------------------------------------------
+  wire [WW-1:0] el_w   = {6'd0, el_q};
+  wire [WW-1:0] age_st = f_tb - f_st;  // ticks since the snapshot
+  wire [WW-1:0] age_pt = f_tb - f_pt;  // ... since the probe latch
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      // the schedule: windows of 2 .. P clocks
+      assert (el_q >= 10'd1 && el_q <= P && cd_q < P && {1'b0, cd_q} + {1'b0, el_q} <= P);
+      // the lane's registers are the low bits of the wide counts; the engine's values are the
+      // wide counts at the last read, which are at most el_q (one a clock) behind
+      assert (p_mpos == f_m[MOT_W-1:0] && p_qcnt == f_q[ERR_W-1:0] && p_gcnt == f_g[ERR_W-1:0]);
+      assert (e_mb == e_m[MOT_W-1:0] && e_qb == e_q[ERR_W-1:0] && e_gb == e_g[ERR_W-1:0]);
+      assert (wdist(f_m, e_m) <= el_w && f_q - e_q <= el_w && f_g - e_g <= el_w);
+      // a capture waiting: taken in this window (or in the clock of the last read)
+      if (p_spend) assert (wdist(f_m, f_sm) <= el_w && wdist(f_sm, e_m) <= el_w && age_st <= el_w &&
+                           p_smpos == f_sm[MOT_W-1:0] && p_stime == f_st[TIM_W-1:0]);
+      if (p_ppend) assert (age_pt <= el_w && p_ptime == f_pt[TIM_W-1:0]);
+      if (rd) begin
+        // the motion, the error and glitch counts: not a step lost
+        assert (e_m_n == f_m);
+        assert (e_q_n == f_q);
+        assert (e_g_n == f_g);
+        // a snapshot: its timebase and its motion; a probe latch: its timebase
+        if (rec[R_SPEND]) assert (tstamp(x_stime, f_tb) == f_st && e_m + sdiff(x_smpos, e_mb) == f_sm);
+        if (rec[R_PPEND]) assert (tstamp(x_ptime, f_tb) == f_pt);
+      end
+    end
+  end
+
+  // ---- covers -------------------------------------------------------------------------------------
+  always @(*) begin
+    if (f_past && !rst) begin
+      cover (rd && e_m_n != e_m && rec[R_SPEND] && rec[R_PPEND]);  // motion, a snapshot, a probe
+      cover (rd && e_q_n != e_q && e_g_n != e_g);                   // errors and glitches counted
+    end
+  end
+
+endmodule
+
+`default_nettype wire
