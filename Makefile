@@ -89,8 +89,8 @@ soc-sim: $(SOC_STAMP) ## LiteX SoC (VexRiscv + enc_qei, Verilator) running sw/so
 	$(PY) scripts/soc_sim.py
 	ENC_SOC_SIM=1 $(PY) -m pytest -q tb/soc
 
-soc-bitstream: $(SOC_STAMP) ## the LiteX SoC with enc_qei on a board through Yosys/nextpnr (BOARD=icebreaker|colorlight_i5); doc/results/soc_bitstream.md
-	@case "$(BOARD)" in icebreaker|colorlight_i5) ;; *) echo "make soc-bitstream: give BOARD=icebreaker or BOARD=colorlight_i5" >&2; exit 2;; esac
+soc-bitstream: $(SOC_STAMP) ## the LiteX SoC with enc_qei on a board through Yosys/nextpnr (BOARD=icebreaker|icebreaker_engine|colorlight_i5|colorlight_i5_engine); doc/results/soc_bitstream.md
+	@case "$(BOARD)" in icebreaker|icebreaker_engine|colorlight_i5|colorlight_i5_engine) ;; *) echo "make soc-bitstream: give BOARD=icebreaker, icebreaker_engine, colorlight_i5 or colorlight_i5_engine" >&2; exit 2;; esac
 	$(PY) scripts/soc_bitstream.py --board $(BOARD)
 
 linux-test: $(LINUX_STAMP) ## the enc-qei Linux counter driver in User-Mode Linux against the RTL (Verilator), checkpatch --strict, W=1, dt-validate

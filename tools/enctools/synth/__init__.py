@@ -10,10 +10,10 @@ channels (`make synth`, doc/results/synth_results.md and synth_channels.md).
 """
 
 from .blocks import BLOCKS, Block, Result, fits
-from .channels import SWEEP_CHANNELS, Fit, channel_table, channels_markdown, fit_line, sweep_block
+from .channels import SWEEP_CHANNELS, Fit, channel_table, channels_markdown, fit_line, sweep_block, sweep_blocks
 from .cli import main, parse_channels, run_jobs
 from .report import changes, markdown, previous_rows, table
 
 __all__ = ["BLOCKS", "Block", "Fit", "Result", "SWEEP_CHANNELS", "changes", "channel_table",
            "channels_markdown", "fit_line", "fits", "main", "markdown", "parse_channels",
-           "previous_rows", "run_jobs", "sweep_block", "table"]
+           "previous_rows", "run_jobs", "sweep_block", "sweep_blocks", "table"]

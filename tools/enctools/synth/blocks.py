@@ -23,8 +23,13 @@ ECP5_DEVICE = ("--25k", "--package", "CABGA256")
 ECP5_DEVICE_NAME = "LFE5U-25F CABGA256"
 ECP5_PINS = 197  # user I/O of the LFE5U-25F in CABGA256
 # what each part holds: logic cells (one LUT4 and one flip-flop each) of the iCE40HX8K, LUT4 and
-# flip-flops of the LFE5U-25F (iCE40 LP/HX and ECP5 family data sheets)
+# flip-flops of the LFE5U-25F; block RAMs: 32 SB_RAM40_4K (4 kbit), 56 DP16KD (18 kbit) (iCE40
+# LP/HX and ECP5 family data sheets)
 CAPACITY = {"hx8k": 7680, "ecp5": 24288}
+BRAM_CAPACITY = {"hx8k": 32, "ecp5": 56}
+BRAM_CELL = {"hx8k": "SB_RAM40_4K", "ecp5": "DP16KD"}
+# the cell nextpnr places a LUT4 in: the iCE40's logic cell, the ECP5's slice half
+PLACED_CELL = {"hx8k": "ICESTORM_LC", "ecp5": "TRELLIS_COMB"}
 FMAX_TARGET_MHZ = 500  # unreachable on purpose: nextpnr then reports the best it achieved
 BOARD_CLOCK_MHZ = 12.0
 SEED = 1
@@ -99,6 +104,17 @@ BLOCKS = [
           seeds=3, quick={"CHANNELS": 2}),
     Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 8}, fmax_goal=75.0, device="ecp5",
           seeds=3, quick=None),
+    # the shared engine (ENGINE 1): 16 lean and 16 full channels on the HX8K, with the engine's
+    # goals, and on the ECP5. --quick places 2 lean channels on the HX8K (the engine's flow and its
+    # block RAMs) and leaves the rest out
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 16, "ENGINE": 1}, lut_goal=2000,
+          fmax_goal=50.0, seeds=3, quick={"CHANNELS": 2}),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 16, "ENGINE": 1}, lut_goal=3500,
+          fmax_goal=50.0, seeds=3, quick=None),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 16, "ENGINE": 1}, device="ecp5",
+          seeds=3, quick=None),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 16, "ENGINE": 1}, device="ecp5",
+          seeds=3, quick=None),
 ]
 
 
@@ -110,14 +126,18 @@ class Result:
     luts: int = 0
     ffs: int = 0
     carries: int = 0
-    brams: int = 0
+    brams: int = 0  # block RAMs: SB_RAM40_4K (iCE40) or DP16KD (ECP5)
+    lutrams: int = 0  # ECP5 distributed RAM (TRELLIS_DPR16X4: 16 x 4 bits in the LUTs of a slice)
     dsps: int = 0
+    placed: int | None = None  # LUT4 sites nextpnr used (PLACED_CELL), with their capacity
+    placed_of: int | None = None
     fmax: float | None = None
     clock_constraint: float | None = None
     port_bits: int = 0
     failures: list = field(default_factory=list)  # reasons this run must fail
     seconds: float = 0.0
     fits: bool = True  # False: more than the part holds, not placed
+    reused: bool = False  # the tool run's inputs were unchanged: its earlier outputs were read
 
 
 def lut_need(res: Result) -> int:
@@ -127,5 +147,8 @@ def lut_need(res: Result) -> int:
 
 
 def fits(res: Result) -> bool:
-    capacity = CAPACITY.get(res.block.device)
-    return capacity is None or max(lut_need(res), res.ffs) <= capacity
+    """Whether the synthesised build fits its part: LUT4 and flip-flops, and block RAMs."""
+    dev = res.block.device
+    capacity = CAPACITY.get(dev)
+    return ((capacity is None or max(lut_need(res), res.ffs) <= capacity) and
+            res.brams <= BRAM_CAPACITY.get(dev, res.brams))

