@@ -132,9 +132,9 @@ async def isolation(dut):
 
 @cocotb_test()
 async def channel_map(dut):
-    """CAPS names the channels, the profile and the architecture (ENGINE); every page below CHANNELS answers its channel
-    registers, a global offset in a page other than 0 and every page at or above CHANNELS answer
-    a bus error; IRQ_SUMMARY bits at and above CHANNELS read 0."""
+    """CAPS names the channels, the profile and the architecture (ENGINE); every page below
+    CHANNELS answers its channel registers, a global offset in a page other than 0 and every page
+    at or above CHANNELS answer a bus error; IRQ_SUMMARY bits at and above CHANNELS read 0."""
     envs, rng = await start_channels(dut)
     bus = envs[0].bus
     n = channels_of(dut)
@@ -143,7 +143,7 @@ async def channel_map(dut):
     profile = {v: k for k, v in enum("CAPS", "PROFILE").items()}[get_field("CAPS", "PROFILE", caps)]
     assert profile == PROFILE_OF[int(dut.PROFILE.value)], f"CAPS.PROFILE {profile}"
     arch = {v: k for k, v in enum("CAPS", "ENGINE").items()}[get_field("CAPS", "ENGINE", caps)]
-    assert arch == ("shared" if int(dut.ENGINE.value) else "per_channel"), f"CAPS.ENGINE {arch}"
+    assert arch == ("shared" if envs[0].engine else "per_channel"), f"CAPS.ENGINE {arch}"
     version = get_field("ID", "VERSION", await bus.rd("ID"))
     assert version >= 0x0101, f"ID.VERSION {version:#06x}: a multi-channel map is 0x0101 or later"
     pages = 1 << (int(dut.ADDR_W.value) - 8)  # the pages the address reaches
