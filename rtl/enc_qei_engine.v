@@ -624,7 +624,7 @@ module enc_qei_engine #(
     input [63:0] c;
     input [63:0] m;
     begin
-      vs_of[V_B]  = (x <= REACH64) | (((~x + 64'd1) & SZ_COUNT) <= REACH64);
+      vs_of[V_B]  = near_mod(x, 64'd0);  // (0 and all ones: the ends, either way round)
       vs_of[V_C]  = (RANGE != 0) & near(x, c);
       vs_of[V_AC] = (RANGE != 0) & (x > c);
       vs_of[V_P]  = (RANGE != 0) & near_mod(x, m);
