@@ -22,6 +22,10 @@
 //     the bus takes (the first of its two reads, or the second when the first met a write of
 //     its word: b_clash) was not read in a clock that wrote that word; the write slots' memory
 //     (u_pend) is never read for a taken write in the clock it is written, on either port;
+//   - the global snapshot: lanes 0 and 1 see the engine's gsnap in its clock (one wire to
+//     every lane); gsnap is raised only while no lane's capture waits unread (the lane proof's
+//     assumption, so each lane takes its snapshot in that clock: formal/enc_qei_lane.sby); a
+//     request (gsnap_req, or one waiting) is taken in the next clock or still waits;
 //   - a bus write is taken once and applied once: per channel, a write waits (pend) or is being
 //     applied (busy), never both; the bus posts a write only into a free slot of a channel with no
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
@@ -121,9 +125,22 @@ module enc_qei_engine_formal #(
   (* keep *) wire                p_wr_on;     // eng.wr_on_q: results are written
   (* keep *) wire                p_pend_we;   // eng.pend_we: the write slots' write
   (* keep *) wire [3:0]          p_pend_wch;  // eng.pend_wch
+  (* keep *) wire [CHANNELS-1:0] p_spend;     // eng.snap_pend: a lane's capture waits (free)
+  (* keep *) wire                p_lsnap0;    // eng.g_lane[0].u_lane.gsnap: lane 0's input
+  (* keep *) wire                p_lsnap1;    // eng.g_lane[1].u_lane.gsnap: lane 1's input
 
   localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_RD1 = 3'd2, B_RD2 = 3'd3, B_POST = 3'd4,
                    B_DONE = 3'd5;
+
+  // ---- the global snapshot's request, as the engine keeps it -------------------------------------
+  (* keep *) wire p_gswait;  // eng.gsnap_wait_q: a request waits for the lanes' captures to be read
+  reg f_past_gsreq = 1'b0, f_past_rst = 1'b1, f_past_gsnap = 1'b0;
+  wire f_gswait = p_gswait;
+  always @(posedge clk) begin
+    f_past_gsreq <= gsnap_req | p_gswait;
+    f_past_rst   <= rst;
+    f_past_gsnap <= gsnap;
+  end
 
   // ---- the port's rules ---------------------------------------------------------------------------
   reg f_past = 1'b0;
@@ -232,6 +249,13 @@ module enc_qei_engine_formal #(
         assert (!(p_pend_we && p_pend_wch == p_cn));
       if (p_slot == 5'd21 && (|(p_pend & p_pend_st & (1 << p_cp))))
         assert (!(p_pend_we && p_pend_wch == p_cp));
+      // the global snapshot (zero skew, with the lane's half in formal/enc_qei_lane.sby): every
+      // lane sees gsnap in the clock the engine raises it, and the engine raises it only while
+      // no lane has a capture waiting that is not read in this clock (what the lane proof
+      // assumes); a request is not lost: it is taken, or waits
+      assert (p_lsnap0 == gsnap && p_lsnap1 == gsnap);
+      if (gsnap) assert ((p_spend & ~p_rd) == {CHANNELS{1'b0}});
+      if (f_past_gsreq && !f_past_rst && !f_past_gsnap) assert (gsnap || f_gswait);
     end
   end
 

@@ -20,7 +20,7 @@
 // (step_up / step_dn, qerr) and filters (glitch_q), and its own timebase: M equals the steps
 // counted (each +1 / -1), the error and glitch counts equal the errors and rejected levels
 // counted; a snapshot waiting at the read has the timebase and the motion of its clock, a probe
-// latch the timebase of its clock. With three bits less of MOT_W or two of ERR_W (the wrapper's
+// latch the timebase of its clock; a global snapshot (gsnap) is taken in its clock. With three bits less of MOT_W or two of ERR_W (the wrapper's
 // MOT_CUT / ERR_CUT, deliberate breaks) it fails; with two and one it passes (MOT_W is sized for
 // the reach of lo, not for the motion).
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
@@ -249,6 +249,9 @@ module enc_qei_lane_formal #(
 
   always @(*) begin
     if (f_past && !rst) begin
+      // zero skew, the lane's half: a global snapshot is taken in its clock (every lane sees
+      // the one gsnap: formal/enc_qei_engine.sby), so every lane's capture is of that clock
+      if (gsnap) assert (p_take);
       // the schedule: windows of 2 .. P clocks
       assert (el_q >= 10'd1 && el_q <= P && cd_q < P && {1'b0, cd_q} + {1'b0, el_q} <= P);
       // the lane's registers are the low bits of the wide counts; the engine's values are the
