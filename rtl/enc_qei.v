@@ -362,17 +362,15 @@ module enc_qei #(
   endgenerate
 
   // ---- interrupt summary --------------------------------------------------------------------------
-  reg [15:0] pending;  // irq_pend, bit k for channel k
-  integer    k;
-
-  always @(*) begin
-    pending = 16'd0;
-    for (k = 0; k < CHANNELS; k = k + 1) begin
-      pending[k] = irq_pend[k];
+  // irq_pend, bit k for channel k (a continuous assignment: a block of irq_pend alone would not
+  // run in a simulation whose irq_pend starts at its final value, and would leave this undefined)
+  generate
+    if (CHANNELS < 16) begin : g_pending
+      assign h2r_irq_summary_pending = {{(16 - CHANNELS){1'b0}}, irq_pend};
+    end else begin : g_pending_all
+      assign h2r_irq_summary_pending = irq_pend;
     end
-  end
-
-  assign h2r_irq_summary_pending = pending;
+  endgenerate
   assign irq = |irq_pend;
 
 endmodule
