@@ -139,7 +139,8 @@ def spec(toplevel: str, test_module: str, name: str, parameters: dict | None = N
          testcase: str | None = None, extra_env: dict | None = None, quiet: bool = False,
          run_tag: str = "", waves: bool | None = None, wave_depth: int = 0,
          vcd: Path | None = None, seed: str | None = None, sim: str | None = None) -> RunSpec:
-    """The RunSpec of a run with the usual sources (see :func:`run`), before the hooks."""
+    """The RunSpec of a run with the usual sources (see :func:`run`), before the hooks (and
+    before the simulator's own build arguments, added after them)."""
     sim = sim or sim_name()
     s = RunSpec(toplevel=toplevel, test_module=test_module, name=name, sim=sim,
                 parameters=dict(parameters or {}),
@@ -148,9 +149,6 @@ def spec(toplevel: str, test_module: str, name: str, parameters: dict | None = N
                 seed=seed or os.environ.get("SEED") or None,
                 waves=waves_enabled() if waves is None else waves, wave_depth=wave_depth, vcd=vcd,
                 quiet=quiet, run_tag=run_tag)
-    if sim == "verilator":
-        # the project's one waiver file (reasons inside): the same one `make lint` uses
-        s.build_args += ["-j", "2", str(RTL / "lint_waivers.vlt")]
     return s
 
 
@@ -213,7 +211,10 @@ def run(toplevel: str, test_module: str, name: str, parameters: dict | None = No
     s = spec(toplevel, test_module, name, parameters, tb_sources, extra_sources, testcase,
              extra_env, quiet, run_tag, waves, wave_depth, vcd, seed, sim)
     for h in _hooks:
-        h.configure(s)
+        h.configure(s)  # (a hook may change the simulator: its build arguments come after)
+    if s.sim == "verilator":
+        # the project's one waiver file (reasons inside): the same one `make lint` uses
+        s.build_args += ["-j", "2", str(RTL / "lint_waivers.vlt")]
     if s.waves and s.sim == "verilator" and s.wave_depth:
         s.build_args += ["--trace-depth", str(s.wave_depth)]
     s.place()
