@@ -45,6 +45,10 @@ async def index(dut):
         preset = rng.randint(100, 200)
         await bus.set64("PRESET", preset)
         model.preset = preset
+        # registers that do not act here hold any value (SNAP_CTRL.PERIOD_EN and CTRL.CMP_EN
+        # stay 0): the shared engine keeps them in one configuration word with PRESET's low bits
+        await bus.wr("SNAP_PERIOD", rng.getrandbits(32) | 0xFF)
+        await bus.set64("COMPARE", rng.getrandbits(32))
         gate = case["gate"]
         word = pack("INDEX_CTRL", ACTION=case["action"], ONESHOT=int(case["oneshot"]),
                     EDGE=case["edge"], GATE_EN=int(gate is not None),
