@@ -135,7 +135,6 @@ module enc_qei_engine_formal #(
   // ---- the global snapshot's request, as the engine keeps it -------------------------------------
   (* keep *) wire p_gswait;  // eng.gsnap_wait_q: a request waits for the lanes' captures to be read
   reg f_past_gsreq = 1'b0, f_past_rst = 1'b1, f_past_gsnap = 1'b0;
-  wire f_gswait = p_gswait;
   always @(posedge clk) begin
     f_past_gsreq <= gsnap_req | p_gswait;
     f_past_rst   <= rst;
@@ -255,7 +254,7 @@ module enc_qei_engine_formal #(
       // assumes); a request is not lost: it is taken, or waits
       assert (p_lsnap0 == gsnap && p_lsnap1 == gsnap);
       if (gsnap) assert ((p_spend & ~p_rd) == {CHANNELS{1'b0}});
-      if (f_past_gsreq && !f_past_rst && !f_past_gsnap) assert (gsnap || f_gswait);
+      if (f_past_gsreq && !f_past_rst && !f_past_gsnap) assert (gsnap || p_gswait);
     end
   end
 
