@@ -104,10 +104,10 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
            write_md: bool = True, table: str = "mutation", command: str = "make mutate") -> int:
     reviewed = load_reviewed()
     head, rows = table_rows(modules, corners, mutants, reviewed)
-    table = [head] + rows
-    widths = [max(len(r[i]) for r in table) for i in range(len(head))]
+    lines = [head] + rows
+    widths = [max(len(r[i]) for r in lines) for i in range(len(head))]
     print()
-    for i, r in enumerate(table):
+    for i, r in enumerate(lines):
         print("  ".join(v.ljust(w) if j == 0 else v.rjust(w) for j, (v, w) in enumerate(zip(r, widths))))
         if i == 0:
             print("  ".join("-" * w for w in widths))
