@@ -20,9 +20,9 @@
 // (step_up / step_dn, qerr) and filters (glitch_q), and its own timebase: M equals the steps
 // counted (each +1 / -1), the error and glitch counts equal the errors and rejected levels
 // counted; a snapshot waiting at the read has the timebase and the motion of its clock, a probe
-// latch the timebase of its clock; a global snapshot (gsnap) is taken in its clock. With three bits less of MOT_W or two of ERR_W (the wrapper's
-// MOT_CUT / ERR_CUT, deliberate breaks) it fails; with two and one it passes (MOT_W is sized for
-// the reach of lo, not for the motion).
+// latch the timebase of its clock; a global snapshot (gsnap) is taken in its clock. With three
+// bits less of MOT_W or two of ERR_W (the wrapper's MOT_CUT / ERR_CUT, deliberate breaks) it
+// fails; with two and one it passes (MOT_W is sized for the reach of lo, not for the motion).
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
 // formal/README.md: that comparison did not finish within the time a task may take).
 `default_nettype none

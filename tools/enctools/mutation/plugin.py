@@ -2,9 +2,8 @@
 """The mutation flow's side of the test runs: a pytest plugin that installs a harness hook.
 
 The flow runs pytest as ``python -m pytest -p enctools.mutation.plugin <pytest ids>``; loading
-the plugin adds one hook to enctools.harness (``harness.add_hook``), chosen by the environment:
-
-Both hooks simulate every run on Icarus (``on_icarus``), also one that names Verilator.
+the plugin adds one hook to enctools.harness (``harness.add_hook``), chosen by the environment
+(both simulate every run on Icarus, ``on_icarus``, also one that names Verilator):
 
 - ``MUT_PLAN=<file>`` (discovery): every ``harness.run()`` is written down instead of built (the
   pytest id, toplevel, parameters, sources, cocotb module, testcase and build key, one JSON line
