@@ -322,34 +322,8 @@ module enc_qei_engine #(
   end
 
   reg [63:0] n_cnt, n_cfg, n_ud, n_pctl, n_pre, n_ceil, n_cmp, n_tmo, n_hi;  // c(v + 1)'s
-  reg [63:0] r_cnt, r_mot, r_evt, r_edge, r_sbase, r_hi, r_cfg, r_pre, r_ceil, r_tmo, r_pctl, r_ud;
+  reg [63:0] o_cnt, o_mot, o_evt, o_edge, o_sbase, o_hi, o_cfg, o_pre, o_ceil, o_tmo, o_pctl, o_ud;
 
-  always @(posedge clk) begin
-    case (slot_q)
-      5'd2:  n_cnt   <= rdata_a;
-      5'd3:  n_cfg   <= rdata_a;
-      5'd4:  n_ud    <= rdata_a;
-      5'd5:  n_pctl  <= rdata_a;
-      5'd6:  n_pre   <= rdata_a;
-      5'd7:  n_ceil  <= rdata_a;
-      5'd8:  n_cmp   <= rdata_a;
-      5'd9:  n_tmo   <= rdata_a;
-      5'd10: n_hi    <= rdata_a;
-      5'd11: r_cnt   <= rdata_a;
-      5'd12: r_mot   <= rdata_a;
-      5'd13: r_evt   <= rdata_a;
-      5'd14: r_edge  <= rdata_a;
-      5'd15: r_sbase <= rdata_a;
-      5'd16: r_hi    <= rdata_a;
-      5'd17: r_cfg   <= rdata_a;
-      5'd18: r_pre   <= rdata_a;
-      5'd19: r_ceil  <= rdata_a;
-      5'd20: r_tmo   <= rdata_a;
-      5'd21: r_pctl  <= rdata_a;
-      5'd22: r_ud    <= rdata_a;
-      default: ;
-    endcase
-  end
 
   wire [63:0] r_stl = rdata_a;  // (in slot 23, the compute's)
 
@@ -473,14 +447,40 @@ module enc_qei_engine #(
   reg [CHANNELS-1:0] fresh_q;  // channel k not visited since rst: its words are the reset values
   // (with two channels visited, c(v + 1) is the channel written in slots 0 .. 19, before its reads)
   wire n_fresh = bit_of(fresh_q, cn_q) & ~(wr_on_q & (cw_q == cn_q));
-  wire [63:0] n_cnt_eff  = n_fresh ? 64'd0 : n_cnt;
-  wire [63:0] n_cfg_eff  = n_fresh ? CFG_RST : n_cfg;
-  wire [63:0] n_pctl_eff = n_fresh ? PCTL_RST : n_pctl;
-  wire [63:0] n_pre_eff  = n_fresh ? PRE_RST : n_pre;
-  wire [63:0] n_ceil_eff = n_fresh ? CEIL_RST : n_ceil;
-  wire [63:0] n_cmp_eff  = n_fresh ? CMP_RST : n_cmp;
-  wire [63:0] n_tmo_eff  = n_fresh ? TMO_RST : n_tmo;
-  wire [63:0] n_hi_eff   = n_fresh ? 64'd0 : n_hi;
+  wire p_fresh = bit_of(fresh_q, cp_q);
+
+  // The words are registered as read, or as their reset values for a channel not visited since
+  // rst (the memory holds nothing for it yet). n_fresh and p_fresh hold for a whole visit (fresh_q
+  // changes in slot 19, for c(v - 1), which is c(v + 1) only once it is written: then n_fresh is
+  // 0 all along), so the reset value is loaded into the register itself: on the iCE40 and the
+  // ECP5 a flip-flop's synchronous set / reset, not a multiplexer after it.
+  always @(posedge clk) begin
+    case (slot_q)
+      5'd2:  n_cnt   <= n_fresh ? 64'd0 : rdata_a;
+      5'd3:  n_cfg   <= n_fresh ? CFG_RST : rdata_a;
+      5'd4:  n_ud    <= rdata_a;  // (used only when the channel is not fresh)
+      5'd5:  n_pctl  <= n_fresh ? PCTL_RST : rdata_a;
+      5'd6:  n_pre   <= n_fresh ? PRE_RST : rdata_a;
+      5'd7:  n_ceil  <= n_fresh ? CEIL_RST : rdata_a;
+      5'd8:  n_cmp   <= n_fresh ? CMP_RST : rdata_a;
+      5'd9:  n_tmo   <= n_fresh ? TMO_RST : rdata_a;
+      5'd10: n_hi    <= n_fresh ? 64'd0 : rdata_a;
+      5'd11: o_cnt   <= p_fresh ? 64'd0 : rdata_a & SZ_COUNT;
+      5'd12: o_mot   <= p_fresh ? 64'd0 : rdata_a;
+      5'd13: o_evt   <= p_fresh ? EVT_RST : rdata_a;
+      5'd14: o_edge  <= p_fresh ? 64'd0 : rdata_a;
+      5'd15: o_sbase <= p_fresh ? 64'd0 : rdata_a;
+      5'd16: o_hi    <= p_fresh ? 64'd0 : rdata_a;
+      5'd17: o_cfg   <= p_fresh ? CFG_RST : rdata_a;
+      5'd18: o_pre   <= p_fresh ? PRE_RST : rdata_a & SZ_COUNT;
+      5'd19: o_ceil  <= p_fresh ? CEIL_RST : rdata_a & SZ_COUNT;
+      5'd20: o_tmo   <= p_fresh ? TMO_RST : rdata_a;
+      5'd21: o_pctl  <= p_fresh ? PCTL_RST : rdata_a;
+      5'd22: o_ud    <= p_fresh ? 64'd0 : rdata_a;
+      default: ;
+    endcase
+  end
+
 
   // ---- a bus write, as the push and the visit apply it ---------------------------------------------
   function [31:0] lanes;  // byte enables -> bit mask
@@ -634,21 +634,21 @@ module enc_qei_engine #(
   wire [41:0] n_w     = n_taken ? n_pend : {SAVE_LATCH, 36'd0};  // (no write: an offset of nothing)
   wire        n_on    = n_taken & (|n_pend[35:32]);
   wire [5:0]  n_off   = n_pend[41:36];
-  wire [63:0] n_cfg_w  = cfg_written(n_cfg_eff, n_w);
-  wire [63:0] n_pre_w  = wide_written(n_pre_eff, n_w, off_of(ENC_QEI_PRESET_LO));
-  wire [63:0] n_ceil_w = (RANGE != 0) ? wide_written(n_ceil_eff, n_w, off_of(ENC_QEI_CEILING_LO)) : n_ceil_eff;
-  wire [63:0] n_cmp_w  = (RANGE != 0) ? wide_written(n_cmp_eff, n_w, off_of(ENC_QEI_COMPARE_LO)) : n_cmp_eff;
-  wire [63:0] n_tmo_w  = tmo_written(n_tmo_eff, n_w);
-  wire [63:0] n_pctl_w = pctl_written(n_pctl_eff, n_w);
+  wire [63:0] n_cfg_w  = cfg_written(n_cfg, n_w);
+  wire [63:0] n_pre_w  = wide_written(n_pre, n_w, off_of(ENC_QEI_PRESET_LO));
+  wire [63:0] n_ceil_w = (RANGE != 0) ? wide_written(n_ceil, n_w, off_of(ENC_QEI_CEILING_LO)) : n_ceil;
+  wire [63:0] n_cmp_w  = (RANGE != 0) ? wide_written(n_cmp, n_w, off_of(ENC_QEI_COMPARE_LO)) : n_cmp;
+  wire [63:0] n_tmo_w  = tmo_written(n_tmo, n_w);
+  wire [63:0] n_pctl_w = pctl_written(n_pctl, n_w);
   wire        n_cnt_wr   = n_on & (n_off == off_of(ENC_QEI_COUNT_LO));
   wire        n_ictrl_wr = n_on & (n_off == off_of(ENC_QEI_INDEX_CTRL));
   wire        n_pctrl_wr = n_on & (n_off == off_of(ENC_QEI_PROBE_CTRL)) & (PROBE != 0);
   wire        n_snap_cmd = n_on & (n_off == off_of(ENC_QEI_SNAP_CTRL)) & n_pend[32] &
                            n_pend[ENC_QEI_SNAP_CTRL_CMD] & (TIMING != 0);
-  wire [63:0] n_val      = {n_hi_eff[63:32], n_pend[31:0]} & SZ_COUNT;  // a COUNT write's value
+  wire [63:0] n_val      = {n_hi[63:32], n_pend[31:0]} & SZ_COUNT;  // a COUNT write's value
   wire [31:0] n_sto      = n_tmo_w[63:32];
-  wire        n_st_new   = (PERIOD != 0) & (n_sto != n_tmo_eff[63:32]);
-  wire        n_uen_old  = n_cfg_eff[41 + ENC_QEI_SNAP_CTRL_PERIOD_EN];
+  wire        n_st_new   = (PERIOD != 0) & (n_sto != n_tmo[63:32]);
+  wire        n_uen_old  = n_cfg[41 + ENC_QEI_SNAP_CTRL_PERIOD_EN];
   wire        n_uen      = n_cfg_w[41 + ENC_QEI_SNAP_CTRL_PERIOD_EN];
   localparam [31:0] TIM_LIM = 32'd1 << TIM_W;  // 2^TIM_W: what the lane times itself is below it
 
@@ -664,7 +664,7 @@ module enc_qei_engine #(
   // verilator lint_on UNUSEDSIGNAL
 
   wire [63:0] n_lc_w   = lane_ceil(n_cfg_w, n_ceil_w);
-  wire [63:0] n_lc_eff = lane_ceil(n_cfg_eff, n_ceil_eff);
+  wire [63:0] n_lc_eff = lane_ceil(n_cfg, n_ceil);
 
   // the validity sets, one a clock (slots 11 .. 17): the count at the last read, PRESET (and the
   // one it replaces), 0, CEILING (and the one it replaces), a COUNT write's value
@@ -673,11 +673,11 @@ module enc_qei_engine #(
 
   always @(*) begin
     case (slot_q)
-      5'd11:   vs_x = n_cnt_eff;
+      5'd11:   vs_x = n_cnt;
       5'd12:   vs_x = n_pre_w;
       5'd13:   vs_x = 64'd0;
       5'd14:   vs_x = n_lc_w;
-      5'd15:   vs_x = n_pre_eff;
+      5'd15:   vs_x = n_pre;
       5'd16:   vs_x = n_lc_eff;
       default: vs_x = n_val;
     endcase
@@ -794,7 +794,7 @@ module enc_qei_engine #(
 
   always @(posedge clk) begin
     if (slot_q == 5'd20) begin
-      cfg_push_q <= push_of(n_cfg_eff, n_pctl_eff, n_tmo_eff, n_val, n_lc_eff, n_cmp_eff,
+      cfg_push_q <= push_of(n_cfg, n_pctl, n_tmo, n_val, n_lc_eff, n_cmp,
                             vs_val_q, n_ud[TIM_W-1:0]);
     end else if (slot_q == 5'd21) begin
       cfg_push_q <= push_of(n_cfg_w, n_pctl_w, n_tmo_w, n_pre_w, n_lc_w, n_cmp_w,
@@ -835,21 +835,8 @@ module enc_qei_engine #(
     end
   end
 
-  wire p_fresh = bit_of(fresh_q, cp_q);
-  // the words as of the end of the window (reset values on the first visit)
-  wire [63:0] o_cnt   = p_fresh ? 64'd0 : r_cnt & SZ_COUNT;
-  wire [63:0] o_mot   = p_fresh ? 64'd0 : r_mot;
-  wire [63:0] o_evt   = p_fresh ? EVT_RST : r_evt;
-  wire [63:0] o_edge  = p_fresh ? 64'd0 : r_edge;
-  wire [63:0] o_sbase = p_fresh ? 64'd0 : r_sbase;
-  wire [63:0] o_hi    = p_fresh ? 64'd0 : r_hi;
-  wire [63:0] o_cfg   = p_fresh ? CFG_RST : r_cfg;
-  wire [63:0] o_pre   = p_fresh ? PRE_RST : r_pre & SZ_COUNT;
-  wire [63:0] o_ceil  = p_fresh ? CEIL_RST : r_ceil & SZ_COUNT;
-  wire [63:0] o_tmo   = p_fresh ? TMO_RST : r_tmo;
-  wire [63:0] o_pctl  = p_fresh ? PCTL_RST : r_pctl;
-  wire [63:0] o_ud    = p_fresh ? 64'd0 : r_ud;
-  wire [63:0] o_stl   = p_fresh ? 64'd0 : r_stl;
+  // the words as of the end of the window (reset values on the first visit: see the loads)
+  wire [63:0] o_stl   = p_fresh ? 64'd0 : r_stl;  // (read in this slot)
 
   wire [MOT_W-1:0] mb = o_mot[32 +: MOT_W];                  // mpos at the last read
   wire [ERR_W-1:0] qb = o_mot[32 + MOT_W +: ERR_W];          // qcnt ...
@@ -1344,7 +1331,7 @@ module enc_qei_engine #(
     end
   endfunction
 
-  // the word as the memory gives it, or its reset value before the channel's first visit
+  // a word's reset value: what the bus reads of a channel before its first visit
   function [63:0] word_rst;
     input [4:0] w;
     begin
@@ -1361,7 +1348,13 @@ module enc_qei_engine #(
     end
   endfunction
 
-  wire [63:0] b_word = b_fresh ? word_rst(word_of(b_word_q)) : rdata_b;
+  // a register's reset value (what a read of a channel not visited since rst gives)
+  function [31:0] reg_rst;
+    input [5:0] off;
+    begin
+      reg_rst = reg_of(off, word_rst(word_of(off)));
+    end
+  endfunction
   // COUNT_LO write: the lanes not written from the count
   wire [31:0] b_cnt_w     = (b_cnt_q & ~lanes(b_wstrb_q)) | (b_wdata_q & lanes(b_wstrb_q));
   wire        b_cnt_whole = b_cnt_lo & (|b_wstrb_q);
@@ -1437,10 +1430,10 @@ module enc_qei_engine #(
         if ((COUNT_W > 32) & b_cnt_lo) begin
           lat_valid_q <= 1'b1;
           lat_ch_q    <= b_ch_q;
-          lat_q       <= b_word[63:32];
+          lat_q       <= b_fresh ? 32'd0 : rdata_b[63:32];  // (COUNT's reset value: 0)
         end
         b_rdata_q <= ((COUNT_W > 32) & b_cnt_hi & lat_valid_q & (lat_ch_q == b_ch_q)) ? lat_q :
-                     reg_of(b_word_q, b_word);
+                     b_fresh ? reg_rst(b_word_q) : reg_of(b_word_q, rdata_b);
       end
     end
   end
@@ -1450,7 +1443,7 @@ module enc_qei_engine #(
 
   wire unused_engine = &{1'b0, o_mot[63:32], o_evt[31:14],
                          d_emp[63:32], d_semp[63:32], n_cfg_w[63:62], r_stl[63:33], o_pctl[31:20],
-                         n_hi_eff[31:0], o_cfg[63:62], n_ud[63:32], o_stl[63:33], d_mpos[63:32],
+                         n_hi[31:0], o_cfg[63:62], n_ud[63:32], o_stl[63:33], d_mpos[63:32],
                          d_smp[63:32], cfg_wr[59], cfg_wr[40], n_pctl_w[63:18], pctl_wr[63:16],
                          1'b0};
 
