@@ -1071,12 +1071,13 @@ module enc_qei_engine #(
   wire [31:0] hi_latch_n = w_save ? w_data : o_hi[31:0];
 
   // the one wide configuration word a write changes (COMPARE: its bytes, with the memory's mask;
-  // a fresh channel's: its reset value)
+  // a fresh channel's: the whole word, its reset value with the write's bytes, for a write can be
+  // taken before a channel's first visit: c(v + 1)'s push in visit v)
   wire        w_cmp_lo = w_on & (w_off == off_of(ENC_QEI_COMPARE_LO)) & (RANGE != 0);
   wire        w_cmp_hi = w_on & (w_off == off_of(ENC_QEI_COMPARE_HI)) & (RANGE != 0);
-  wire [63:0] cmp_mask = p_fresh ? {64{1'b1}} :
-                         w_cmp_lo ? {32'd0, w_mask} : w_cmp_hi ? {w_mask, 32'd0} : 64'd0;
-  wire [63:0] cmp_data = p_fresh ? CMP_RST : ({w_data, w_data} & SZ_COUNT);
+  wire [63:0] cmp_wr   = w_cmp_lo ? {32'd0, w_mask} : w_cmp_hi ? {w_mask, 32'd0} : 64'd0;
+  wire [63:0] cmp_mask = p_fresh ? {64{1'b1}} : cmp_wr;
+  wire [63:0] cmp_data = (({w_data, w_data} & cmp_wr) | (CMP_RST & ~cmp_wr)) & SZ_COUNT;
 
   // ---- the results (registered at the end of slot 23) and their writes, slots 0 .. 19 ------------------
   reg [63:0] n_cnt_q, n_cfg_q, n_ud_q, n_pctl_q, n_pre_q, n_ceil_q, n_cmpd_q, n_cmpm_q, n_tmo_q;

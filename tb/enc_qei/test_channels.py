@@ -20,7 +20,8 @@ from hedsmodel import QUAD, random_walk, walk
 from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, wb_abandon_read
 from enctools.qei.env import FILTER, begin, build_name, channel_envs
 from enctools.qei.model import QUAD_FUNCS, QeiModel
-from enctools.regmap import PAGE, addr, enum, get_field, pack, regmap
+from enctools.qei.stimulus import pulse_rst
+from enctools.regmap import PAGE, addr, built_mask, enum, get_field, pack, regmap, units
 from enctools.tb import cocotb_test
 
 # (top, CHANNELS, PROFILE, COUNT_W, TS_W, ENGINE)
@@ -150,6 +151,38 @@ async def isolation(dut):
                        if before[j][r] != after[r]}
             assert not changed, f"traffic to channel {k} changed channel {j}: {changed}"
     dut._log.info("%d channels: every register of every other channel unchanged", n)
+
+
+# the channel registers a write keeps as written (the counting and the state registers excluded)
+KEPT_REGS = tuple(r for r in CHAN_REGS
+                  if r not in ("COUNT_LO", "COUNT_HI", "EVENTS", "QERR_COUNT", "GLITCH_COUNT")
+                  and any(f.sw == "rw" for f in regmap()[r].fields.values()))
+
+
+@cocotb_test()
+async def writes_after_reset(dut):
+    """A write in the first clocks after rst is released (0 to 7 clocks after), of every register
+    a channel keeps as written, on every channel with a random value, reads back what it wrote in
+    its read-write fields. (The shared engine takes a channel's write before its first visit
+    since rst, which writes the registers' reset values: the write must act on them.)"""
+    envs, rng = await start_channels(dut)
+    bus = envs[0].bus
+    have = units(await bus.rd("CAPS"))
+    lost = []
+    for k in range(len(envs)):
+        for reg in KEPT_REGS:
+            mask = sum(built_mask(f, envs[0].count_w, 32, have) for f in regmap()[reg].fields.values()
+                       if f.sw == "rw")
+            if not mask:
+                continue
+            value = rng.getrandbits(32)
+            await pulse_rst(dut, 2)
+            await ClockCycles(dut.clk, rng.randrange(8))
+            await bus.at(k).wr(reg, value)
+            got = await bus.at(k).rd(reg)
+            if got & mask != value & mask:
+                lost.append((k, reg, hex(value & mask), hex(got & mask)))
+    assert not lost, f"writes right after rst not kept (channel, register, written, read): {lost}"
 
 
 @cocotb_test()
