@@ -4,8 +4,9 @@ the same time, isolation of the channel pages, the map of a multi-channel build 
 unmapped offsets), the global snapshot (by GSNAP_CTRL.CMD, by snap_in, by the unit timer; every
 channel latched in one clock, SNAP_TIME shared) and IRQ_SUMMARY.
 
-Runs on CHANNEL_CONFIGS (enc_qei_wb with 3 full channels, enc_qei_axil with 4 lean ones, random
-AXI back-pressure). Each channel has its own model (enctools.qei.model); a lean channel's model
+Runs on CHANNEL_CONFIGS (a datapath per channel: enc_qei_wb with 3 full channels, enc_qei_axil
+with 4 lean ones, random AXI back-pressure; the shared engine at 2, 3 and 16 channels, both
+buses, both profiles, COUNT_W 64 with TS_W 16 at 2). Each channel has its own model (enctools.qei.model); a lean channel's model
 has no compare unit. Every cocotb test logs its seed (make test SEED=n reproduces a run).
 """
 
@@ -24,9 +25,12 @@ from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import PAGE, addr, built_mask, enum, get_field, pack, regmap, units
 from enctools.tb import cocotb_test
 
-# (top, CHANNELS, PROFILE, COUNT_W, TS_W, ENGINE)
+# (top, CHANNELS, PROFILE, COUNT_W, TS_W, ENGINE); the engine at 2 channels (the channel whose
+# results are written in a visit is the one its push reads), 3 and 16 (on Verilator whatever SIM
+# says: Icarus takes about 30 times longer)
 CHANNEL_CONFIGS = (("enc_qei_wb", 3, "full", 32, 32, 0), ("enc_qei_axil", 4, "lean", 32, 32, 0),
-                   ("enc_qei_wb", 3, "lean", 32, 32, 1), ("enc_qei_axil", 3, "full", 32, 32, 1))
+                   ("enc_qei_wb", 3, "lean", 32, 32, 1), ("enc_qei_axil", 3, "full", 32, 32, 1),
+                   ("enc_qei_axil", 2, "lean", 64, 16, 1), ("enc_qei_wb", 16, "full", 32, 32, 1))
 SNAP_REGS = ("SNAP_COUNT_LO", "SNAP_COUNT_HI", "SNAP_TIME", "SNAP_EDGE_TIME", "SNAP_DELTA",
              "SNAP_EDGE_DELTA")
 CHAN_REGS = tuple(n for n, r in regmap().items() if r.group == "chan")
@@ -58,9 +62,10 @@ def bound_walk(rng, n: int, shortest: float, p_reverse: float, start_pos: int, d
     probability p_reverse at each transition), except that the state a reversal leaves lasts at
     least ``dither`` clocks: that state is a level of one channel that spans no change of the
     other (the dither of a reversal), which the filter rejects when it is shorter than FILTER_LEN
-    samples. x4, x2 and x1 count the same with the dither or without it; x1_hyst does not (its
-    hysteresis keeps the count it had before a dither it never saw), so its walks keep every
-    dither long enough for the filter to pass."""
+    samples. x4, x2 and x1 count the same with the dither or without it, but GLITCH and
+    DIR_CHANGE differ (a rejected dither at the start of a reversal removes the change of
+    direction); x1_hyst's count differs too (its hysteresis keeps the count it had before a
+    dither it never saw)."""
     direction, steps, durs = 1, [], []
     for i in range(n):
         if rng.random() < p_reverse:
@@ -77,9 +82,10 @@ def bound_walk(rng, n: int, shortest: float, p_reverse: float, start_pos: int, d
 async def independent_walks(dut):
     """Every channel plays its own random walk (runs at the count-rate bound, dither, index pulses)
     at the same time, with its own count function and index action; each channel's COUNT, EVENTS
-    and INDEX_LATCH are checked against its own model. At the bound a reversal's dither may be
-    shorter than the filter: the x4, x2 and x1 channels play it so, the x1_hyst ones play it long
-    enough to pass (bound_walk)."""
+    and INDEX_LATCH are checked against its own model. At the bound a channel plays a reversal's
+    dither either long enough for the filter to pass, with every event checked, or (x4, x2 and x1
+    only, half of the time) as short as the other states, with the count still exact but GLITCH
+    and DIR_CHANGE not compared (bound_walk)."""
     envs, rng = await start_channels(dut)
     models = [QeiModel(env.count_w) for env in envs]
     funcs = [rng.choice(QUAD_FUNCS) for _ in envs]
@@ -87,17 +93,19 @@ async def independent_walks(dut):
         await env.setup(model, func=func, count=rng.getrandbits(env.count_w))
         await set_index(env, model, rng)
     dut._log.info("count functions per channel: %s", funcs)
+    short = [False] * len(envs)  # this round, channel k plays short dithers
     for rnd in range(4):
         tasks = []
         for k, (env, model) in enumerate(zip(envs, models)):
             p_rev = rng.choice((0.02, 0.2, 0.5))
             # rounds 0 and 1 at the count-rate bound (states of 1.05 max(1, F/2) clocks and up)
             shortest = 1.05 * max(1, FILTER / 2) if rnd < 2 else 1.05 * FILTER
-            dither = 1.05 * FILTER if funcs[k] == "x1_hyst" else shortest
+            short[k] = rnd < 2 and funcs[k] != "x1_hyst" and rng.random() < 0.5
+            dither = shortest if short[k] else 1.05 * FILTER
             wf = bound_walk(rng, rng.randint(80, 200), shortest, p_rev, env.pos, dither)
             period = rng.choice((24, 40, 64))
-            # (at the bound a reversal makes one-state pulses, shorter than the filter: no index
-            # there, and the filter's GLITCH flag is expected)
+            # (no index pulses at the bound: a one-state level there may be shorter than the
+            # filter)
             zf = (lambda p, n=period: int(5 <= p % n <= 7)) if rnd >= 2 else None
             tasks.append(cocotb.start_soon(env.play(wf, model, zfun=zf)))
         for t in tasks:
@@ -106,8 +114,9 @@ async def independent_walks(dut):
             what = f"channel {k} ({funcs[k]}), round {rnd}"
             await env.check(model, what, events=False)
             ev, exp = await env.bus.events(), model.take_events()
-            if rnd < 2:
-                ev.discard("GLITCH")
+            if short[k]:
+                ev -= {"GLITCH", "DIR_CHANGE"}
+                exp -= {"GLITCH", "DIR_CHANGE"}
             assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
             latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
             assert latch == model.idx_latch, \
@@ -153,9 +162,10 @@ async def isolation(dut):
     dut._log.info("%d channels: every register of every other channel unchanged", n)
 
 
-# the channel registers a write keeps as written (the counting and the state registers excluded)
+# the channel registers a write keeps as written while the encoders stand still (COUNT_HI, whose
+# reads go through COUNT_LO's latch, and the state registers excluded)
 KEPT_REGS = tuple(r for r in CHAN_REGS
-                  if r not in ("COUNT_LO", "COUNT_HI", "EVENTS", "QERR_COUNT", "GLITCH_COUNT")
+                  if r not in ("COUNT_HI", "EVENTS", "QERR_COUNT", "GLITCH_COUNT")
                   and any(f.sw == "rw" for f in regmap()[r].fields.values()))
 
 
@@ -269,6 +279,7 @@ async def global_snapshot(dut):
     if len(set(edges)) > 1:  # one SNAP_CTRL.EDGE for all, so that the edge times compare
         for env in envs:
             await env.bus.wr("SNAP_CTRL", edges[0])
+        await envs[0].applied()  # (the shared engine: every channel's before the motion starts)
 
     def motion(steps: int):
         return drv.start(random_walk(rng, steps, 1.05 * FILTER * T_NS + 0.1, 2 * FILTER * T_NS,
@@ -487,4 +498,4 @@ def test_channels(top, channels, profile, count_w, ts_w, engine):
     code = enum("CAPS", "PROFILE")[profile]
     run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}_e{engine}",
         parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code,
-                    "ENGINE": engine})
+                    "ENGINE": engine}, sim="verilator" if channels > 4 else None)
