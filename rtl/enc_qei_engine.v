@@ -1065,23 +1065,29 @@ module enc_qei_engine #(
   wire [63:0] cfg_n  = {cfg_wr[63:60], rec_q[R_PEN] & (PROBE != 0), cfg_wr[58:41],
                         rec_q[R_ARM], cfg_wr[39:0]};
 
-  // COUNT_HI: a write stages its word; a saved latch
-  wire [31:0] hi_stage_n = w_cnt_hi ? ((o_hi[63:32] & ~w_mask) | (w_data & w_mask)) & SZ_COUNT[63:32] :
-                           o_hi[63:32];
-  wire [31:0] hi_latch_n = w_save ? w_data : o_hi[31:0];
-
-  // the one wide configuration word a write changes (COMPARE: its bytes, with the memory's mask;
-  // a fresh channel's: the whole word, its reset value with the write's bytes, for a write can be
-  // taken before a channel's first visit: c(v + 1)'s push in visit v)
-  wire        w_cmp_lo = w_on & (w_off == off_of(ENC_QEI_COMPARE_LO)) & (RANGE != 0);
-  wire        w_cmp_hi = w_on & (w_off == off_of(ENC_QEI_COMPARE_HI)) & (RANGE != 0);
-  wire [63:0] cmp_wr   = w_cmp_lo ? {32'd0, w_mask} : w_cmp_hi ? {w_mask, 32'd0} : 64'd0;
-  wire [63:0] cmp_mask = p_fresh ? {64{1'b1}} : cmp_wr;
-  wire [63:0] cmp_data = (({w_data, w_data} & cmp_wr) | (CMP_RST & ~cmp_wr)) & SZ_COUNT;
+  // The words a write changes in place: PRESET, CEILING, COMPARE, SNAP_PERIOD / STALL_TIMEOUT
+  // and COUNT_HI (its staged word: a COUNT_HI write; its latch: a saved latch). The memory takes
+  // the write's bytes with its mask and keeps the rest; a fresh channel's word is written whole,
+  // its reset value with the write's bytes (a write can be taken before a channel's first visit:
+  // c(v + 1)'s push in visit v).
+  wire w_pre_lo  = w_on & (w_off == off_of(ENC_QEI_PRESET_LO));
+  wire w_pre_hi  = w_on & (w_off == off_of(ENC_QEI_PRESET_HI));
+  wire w_ceil_lo = w_on & (w_off == off_of(ENC_QEI_CEILING_LO)) & (RANGE != 0);
+  wire w_ceil_hi = w_on & (w_off == off_of(ENC_QEI_CEILING_HI)) & (RANGE != 0);
+  wire w_cmp_lo  = w_on & (w_off == off_of(ENC_QEI_COMPARE_LO)) & (RANGE != 0);
+  wire w_cmp_hi  = w_on & (w_off == off_of(ENC_QEI_COMPARE_HI)) & (RANGE != 0);
+  wire w_sper    = w_on & (w_off == off_of(ENC_QEI_SNAP_PERIOD)) & (PERIOD != 0);
+  wire w_stov    = w_on & (w_off == off_of(ENC_QEI_STALL_TIMEOUT)) & (PERIOD != 0);
 
   // ---- the results (registered at the end of slot 23) and their writes, slots 0 .. 19 ------------------
-  reg [63:0] n_cnt_q, n_cfg_q, n_ud_q, n_pctl_q, n_pre_q, n_ceil_q, n_cmpd_q, n_cmpm_q, n_tmo_q;
-  reg [63:0] n_hi_q, n_mot_q, n_evt_q, n_edge_q, n_sbase_q, n_scnt_q, n_stime_q, n_sdelta_q;
+  reg [63:0] n_cnt_q, n_cfg_q, n_ud_q, n_pctl_q;
+  reg [63:0] n_mot_q, n_evt_q, n_edge_q, n_sbase_q, n_scnt_q, n_stime_q, n_sdelta_q;
+  // the write for the words it changes in place: its data and byte lanes, which halves of which
+  // word it writes ({hi, lo}: PRESET, CEILING, COMPARE, SNAP_PERIOD / STALL_TIMEOUT, COUNT_HI's
+  // stage / latch), and whether the channel is fresh
+  reg [31:0] ip_data_q, ip_lanes_q;
+  reg [1:0]  ip_pre_q, ip_ceil_q, ip_cmp_q, ip_tmo_q, ip_hi_q;
+  reg        ip_fresh_q;
   reg [63:0] n_ilatch_q, n_platch_q, n_ptime_q, n_stl_q;
   reg        n_snap_q, n_latch_q, n_probe_q;  // the snapshot words / INDEX_LATCH / PROBE_* to write
   reg        n_irq_q;
@@ -1092,12 +1098,14 @@ module enc_qei_engine #(
       n_cfg_q    <= cfg_n;
       n_ud_q     <= {tv, ud_n};
       n_pctl_q   <= pctl_n;
-      n_pre_q    <= wide_written(o_pre, w_w, off_of(ENC_QEI_PRESET_LO));
-      n_ceil_q   <= (RANGE != 0) ? wide_written(o_ceil, w_w, off_of(ENC_QEI_CEILING_LO)) : o_ceil;
-      n_cmpd_q   <= cmp_data;
-      n_cmpm_q   <= cmp_mask;
-      n_tmo_q    <= tmo_n;
-      n_hi_q     <= {hi_stage_n, hi_latch_n};
+      ip_data_q  <= w_data;
+      ip_lanes_q <= w_mask;
+      ip_pre_q   <= {w_pre_hi, w_pre_lo};
+      ip_ceil_q  <= {w_ceil_hi, w_ceil_lo};
+      ip_cmp_q   <= {w_cmp_hi, w_cmp_lo};
+      ip_tmo_q   <= {w_stov, w_sper};
+      ip_hi_q    <= {w_cnt_hi, w_save};
+      ip_fresh_q <= p_fresh;
       n_mot_q    <= {{(32 - MOT_W - 2 * ERR_W){1'b0}}, x_gcnt, x_qcnt, x_mpos, m_r};
       n_evt_q    <= {glitch_n, qerr_n, 8'd0, status_n, 2'd0, events_n};
       n_edge_q   <= {me_n, te_n};
@@ -1116,6 +1124,27 @@ module enc_qei_engine #(
     end
   end
 
+  // a word written in place: the write's bytes in the halves it writes, the reset value elsewhere
+  // (what a fresh channel's word takes), within the word's size sz
+  function [63:0] ip_data;
+    input [1:0]  on;   // {hi, lo}: the halves the write writes
+    input [63:0] r0;   // the reset value
+    input [63:0] sz;
+    reg   [63:0] m;
+    begin
+      m       = {on[1] ? ip_lanes_q : 32'd0, on[0] ? ip_lanes_q : 32'd0};
+      ip_data = (({ip_data_q, ip_data_q} & m) | (r0 & ~m)) & sz;
+    end
+  endfunction
+
+  function [63:0] ip_mask;  // ... and the bits the memory takes (a fresh channel's: all)
+    input [1:0] on;
+    begin
+      ip_mask = ip_fresh_q ? {64{1'b1}} :
+                {on[1] ? ip_lanes_q : 32'd0, on[0] ? ip_lanes_q : 32'd0};
+    end
+  endfunction
+
   // slot i writes word i of this order (slots 0 .. 19; the configuration words first: with two
   // channels visited the next push reads them in slots 1 .. 9)
   always @(*) begin
@@ -1125,11 +1154,16 @@ module enc_qei_engine #(
       5'd1:  begin waddr = {cw_q, W_CFG};    wdata = n_cfg_q;    end
       5'd2:  begin waddr = {cw_q, W_UD};     wdata = n_ud_q;     end
       5'd3:  begin waddr = {cw_q, W_PCTL};   wdata = n_pctl_q;   end
-      5'd4:  begin waddr = {cw_q, W_PRESET}; wdata = n_pre_q;    end
-      5'd5:  begin waddr = {cw_q, W_CEIL};   wdata = n_ceil_q;   end
-      5'd6:  begin waddr = {cw_q, W_CMP};    wdata = n_cmpd_q;   wmask = n_cmpm_q; end
-      5'd7:  begin waddr = {cw_q, W_TMO};    wdata = n_tmo_q;    end
-      5'd8:  begin waddr = {cw_q, W_HI};     wdata = n_hi_q;     end
+      5'd4:  begin waddr = {cw_q, W_PRESET}; wdata = ip_data(ip_pre_q, PRE_RST, SZ_COUNT);
+                   wmask = ip_mask(ip_pre_q); end
+      5'd5:  begin waddr = {cw_q, W_CEIL};   wdata = ip_data(ip_ceil_q, CEIL_RST, SZ_COUNT);
+                   wmask = ip_mask(ip_ceil_q); end
+      5'd6:  begin waddr = {cw_q, W_CMP};    wdata = ip_data(ip_cmp_q, CMP_RST, SZ_COUNT);
+                   wmask = ip_mask(ip_cmp_q); end
+      5'd7:  begin waddr = {cw_q, W_TMO};    wdata = ip_data(ip_tmo_q, TMO_RST, {SZ_TS, SZ_TS});
+                   wmask = ip_mask(ip_tmo_q); end
+      5'd8:  begin waddr = {cw_q, W_HI};     wdata = ip_data(ip_hi_q, 64'd0, {SZ_COUNT[63:32], 32'hFFFFFFFF});
+                   wmask = ip_mask(ip_hi_q); end
       5'd9:  begin waddr = {cw_q, W_MOT};    wdata = n_mot_q;    end
       5'd10: begin waddr = {cw_q, W_EDGE};   wdata = n_edge_q;   end
       5'd11: begin waddr = {cw_q, W_SBASE};  wdata = n_sbase_q;  end
@@ -1446,7 +1480,7 @@ module enc_qei_engine #(
                          d_emp[63:32], d_semp[63:32], n_cfg_w[63:62], r_stl[63:33], o_pctl[31:20],
                          n_hi[31:0], o_cfg[63:62], n_ud[63:32], o_stl[63:33], d_mpos[63:32],
                          d_smp[63:32], cfg_wr[59], cfg_wr[40], n_pctl_w[63:18], pctl_wr[63:16],
-                         1'b0};
+                         tmo_n[63:32], o_hi[31:0], 1'b0};
 
 endmodule
 
