@@ -322,8 +322,7 @@ module enc_qei_engine #(
   end
 
   reg [63:0] n_cnt, n_cfg, n_ud, n_pctl, n_pre, n_ceil, n_cmp, n_tmo, n_hi;  // c(v + 1)'s
-  reg [63:0] o_cnt, o_mot, o_evt, o_edge, o_sbase, o_hi, o_cfg, o_pre, o_ceil, o_tmo, o_pctl, o_ud;
-
+  reg [63:0] o_cnt, o_mot, o_evt, o_edge, o_sbase, o_hi, o_cfg, o_pre, o_ceil, o_tmo, o_pctl, o_ud;  // c(v)'s
 
   wire [63:0] r_stl = rdata_a;  // (in slot 23, the compute's)
 
@@ -480,7 +479,6 @@ module enc_qei_engine #(
       default: ;
     endcase
   end
-
 
   // ---- a bus write, as the push and the visit apply it ---------------------------------------------
   function [31:0] lanes;  // byte enables -> bit mask
@@ -1126,22 +1124,26 @@ module enc_qei_engine #(
 
   // a word written in place: the write's bytes in the halves it writes, the reset value elsewhere
   // (what a fresh channel's word takes), within the word's size sz
+  function [63:0] ip_bits;  // the bits the write writes: its byte lanes in the halves on = {hi, lo}
+    input [1:0] on;
+    begin
+      ip_bits = {on[1] ? ip_lanes_q : 32'd0, on[0] ? ip_lanes_q : 32'd0};
+    end
+  endfunction
+
   function [63:0] ip_data;
-    input [1:0]  on;   // {hi, lo}: the halves the write writes
+    input [1:0]  on;
     input [63:0] r0;   // the reset value
     input [63:0] sz;
-    reg   [63:0] m;
     begin
-      m       = {on[1] ? ip_lanes_q : 32'd0, on[0] ? ip_lanes_q : 32'd0};
-      ip_data = (({ip_data_q, ip_data_q} & m) | (r0 & ~m)) & sz;
+      ip_data = (({ip_data_q, ip_data_q} & ip_bits(on)) | (r0 & ~ip_bits(on))) & sz;
     end
   endfunction
 
   function [63:0] ip_mask;  // ... and the bits the memory takes (a fresh channel's: all)
     input [1:0] on;
     begin
-      ip_mask = ip_fresh_q ? {64{1'b1}} :
-                {on[1] ? ip_lanes_q : 32'd0, on[0] ? ip_lanes_q : 32'd0};
+      ip_mask = ip_fresh_q ? {64{1'b1}} : ip_bits(on);
     end
   endfunction
 
