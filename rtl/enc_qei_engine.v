@@ -322,7 +322,8 @@ module enc_qei_engine #(
   end
 
   reg [63:0] n_cnt, n_cfg, n_ud, n_pctl, n_pre, n_ceil, n_cmp, n_tmo, n_hi;  // c(v + 1)'s
-  reg [63:0] o_cnt, o_mot, o_evt, o_edge, o_sbase, o_hi, o_cfg, o_pre, o_ceil, o_tmo, o_pctl, o_ud;  // c(v)'s
+  // c(v)'s, as of the end of its window
+  reg [63:0] o_cnt, o_mot, o_evt, o_edge, o_sbase, o_hi, o_cfg, o_pre, o_ceil, o_tmo, o_pctl, o_ud;
 
   wire [63:0] r_stl = rdata_a;  // (in slot 23, the compute's)
 
