@@ -2,12 +2,13 @@
 """enc_qei with several channels behind one bus: every channel counting its own modelled walk at
 the same time, isolation of the channel pages, the map of a multi-channel build (CAPS, pages,
 unmapped offsets), the global snapshot (by GSNAP_CTRL.CMD, by snap_in, by the unit timer; every
-channel latched in one clock, SNAP_TIME shared) and IRQ_SUMMARY.
+channel latched in one clock, SNAP_TIME shared), IRQ_SUMMARY and writes right after rst.
 
 Runs on CHANNEL_CONFIGS (a datapath per channel: enc_qei_wb with 3 full channels, enc_qei_axil
 with 4 lean ones, random AXI back-pressure; the shared engine at 2, 3 and 16 channels, both
-buses, both profiles, COUNT_W 64 with TS_W 16 at 2). Each channel has its own model (enctools.qei.model); a lean channel's model
-has no compare unit. Every cocotb test logs its seed (make test SEED=n reproduces a run).
+buses, both profiles, COUNT_W 64 with TS_W 16 at 2). Each channel has its own model
+(enctools.qei.model); a lean channel's model has no compare unit. Every cocotb test logs its
+seed (make test SEED=n reproduces a run).
 """
 
 from __future__ import annotations
@@ -178,10 +179,11 @@ async def writes_after_reset(dut):
     envs, rng = await start_channels(dut)
     bus = envs[0].bus
     have = units(await bus.rd("CAPS"))
+    count_w, ts_w = envs[0].count_w, int(dut.TS_W.value)
     lost = []
     for k in range(len(envs)):
         for reg in KEPT_REGS:
-            mask = sum(built_mask(f, envs[0].count_w, 32, have) for f in regmap()[reg].fields.values()
+            mask = sum(built_mask(f, count_w, ts_w, have) for f in regmap()[reg].fields.values()
                        if f.sw == "rw")
             if not mask:
                 continue
