@@ -5,8 +5,10 @@ decoders still count exactly, for FILTER_LEN = 1..4, against the contract's boun
 
 For each F it plays random walks of N transitions (states uniform [S, 2S] clocks, edges off the
 clock grid, 30% reversals) for several seeds, at S = bound x ratio for ratios going down from
-1.10, and reports the smallest S at which every seed at that S and above was exact. Exact means
-the 4X and 2X counts equal the true position and the 1X count stays in its hysteresis band.
+1.10, and reports the smallest S at which every seed at that S and above was exact; then it
+plays the same walks at 0.8 x the bound and reports how many missed, each of which must be
+flagged. Exact means the 4X and 2X counts equal the true position and the 1X count stays in its
+hysteresis band.
 With --dut qei the same walks go through the peripheral: enc_qei_wb, FUNC x4, CTRL.FILTER_LEN set
 at run time, COUNT read over Wishbone; exact means COUNT equals the true 4X position, and a miss
 must have set QERR or GLITCH. With --dut engine the walks go through the shared engine
@@ -33,6 +35,7 @@ from pathlib import Path
 from .paths import TOP
 
 RATIOS = (1.10, 1.07, 1.05, 1.03, 1.02, 1.01, 1.00, 0.99, 0.98, 0.97, 0.95, 0.92, 0.90)
+FLAG_RATIO = 0.80  # well below the bound: every inexact walk must be flagged (QERR / GLITCH)
 
 
 def positive_int(text: str) -> int:
@@ -125,21 +128,34 @@ def main() -> int:
                 failed_at = s
                 break
             smallest_exact = s
-        return dut, f, bound, smallest_exact, failed_at
+        # well below the bound: how many walks miss, and that each one that does is flagged
+        s = round(bound * FLAG_RATIO, 4)
+        results = run_points(dut, f, [{"s": s, "n": args.transitions, "seed": args.seed * f + k}
+                                      for k in range(args.seeds)])
+        inexact = [r for r in results if not r["exact"]]
+        silent = [r for r in inexact if not r["flagged"]]
+        print(f"count_rate: {dut} F={f} S={s:.3f} clocks ({FLAG_RATIO:.2f} x bound): "
+              f"{len(inexact)} of {len(results)} walks inexact, {len(inexact) - len(silent)} of them "
+              f"flagged  [{time.time() - t0:.0f} s]", flush=True)
+        if silent:
+            raise SystemExit(f"count_rate: silent miscount: {silent[0]}")
+        return dut, f, bound, smallest_exact, failed_at, (len(inexact), len(results))
 
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         rows = list(pool.map(one_filter, [(d, f) for d in duts for f in args.filters]))
 
-    header = ["| circuit | FILTER_LEN | bound max(1, F/2) (clocks) | smallest exact S (clocks) | ratio to bound | first failing S |",
-              "|---|---:|---:|---:|---:|---:|"]
+    header = ["| circuit | FILTER_LEN | bound max(1, F/2) (clocks) | smallest exact S (clocks) | ratio to bound | "
+              f"first failing S | at {FLAG_RATIO:.2f} x bound: walks inexact, all flagged |",
+              "|---|---:|---:|---:|---:|---:|---|"]
     new = {}
     ok = True
-    for dut, f, bound, s, failed in rows:
+    for dut, f, bound, s, failed, (n_inexact, n_walks) in rows:
         ratio = s / bound if s else float("nan")
         ok &= s is not None and abs(ratio - 1) <= 0.05
         new.setdefault(DUTS[dut], []).append(
             f"| {DUTS[dut]} | {f} | {bound:.2f} | {s if s else '-'} | {ratio:.2f} | "
-            f"{failed if failed else 'none down to ' + str(round(bound * RATIOS[-1], 3))} |")
+            f"{failed if failed else 'none down to ' + str(round(bound * RATIOS[-1], 3))} | "
+            f"{n_inexact} of {n_walks} |")
     table = "\n".join(header + [row for name in DUTS.values() for row in new.get(name, [])])
     note = (f"\n{args.seeds} seeds x {args.transitions:,} transitions per point, states uniform "
             f"[S, 2S] clock periods, edges off the clock grid, simulator {os.environ['SIM']}"
