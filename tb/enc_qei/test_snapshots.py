@@ -428,6 +428,36 @@ async def snapshot_edge_delta_after_reversal(dut):
 
 
 @cocotb_test()
+async def snapshot_deltas_backward(dut):
+    """SNAP_DELTA and SNAP_EDGE_DELTA when the motion since reset is negative: the shaft first
+    turns backward from reset, so the motion a snapshot keeps (the base of the next delta) has
+    every high bit set; then segments backward and forward, a snapshot after each. Each delta is
+    the steps between the two snapshots, whatever the motion's absolute value."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=rng.getrandbits(16), filter_len=1)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+    await env.settle(4)
+    model.delta = 0
+    for n, way in ((rng.randint(20, 60), -1), (rng.randint(5, 30), -1), (rng.randint(70, 120), 1),
+                   (rng.randint(100, 160), -1), (rng.randint(5, 30), 1)):
+        steps = [way] * n
+        wf = walk(steps, durations(rng, n, f=1), start_pos=env.pos)
+        await env.play(wf, model)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        snap = await read_snapshot(bus)
+        assert signed(snap["delta"]) == model.delta, \
+            f"after {n} x {way:+d}: SNAP_DELTA {signed(snap['delta'])}, model {model.delta}"
+        # (EDGE any: every step is at an edge)
+        assert signed(snap["edge_delta"]) == model.delta, \
+            f"after {n} x {way:+d}: SNAP_EDGE_DELTA {signed(snap['edge_delta'])}, model {model.delta}"
+        model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
 async def global_snapshot_one_channel(dut):
     """The global snapshot of a one-channel build: by GSNAP_CTRL.CMD (ten of them, at timebase
     values 173 clocks and a bus transfer apart), by a rising snap_in with GSNAP_CTRL.IN_EN (none
