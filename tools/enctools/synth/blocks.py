@@ -118,10 +118,14 @@ BLOCKS = [
 ]
 
 
+# a nextpnr run longer than this is stopped (a router that does not converge); --pnr-limit
+PNR_LIMIT_MIN = 60.0
+
+
 @dataclass
 class Result:
     block: Block
-    status: str = "ok"  # ok | missing | error
+    status: str = "ok"  # ok | missing | error | stopped (one seed: the route time limit)
     note: str = ""
     luts: int = 0
     ffs: int = 0
@@ -138,6 +142,7 @@ class Result:
     seconds: float = 0.0
     fits: bool = True  # False: more than the part holds, not placed
     reused: bool = False  # the tool run's inputs were unchanged: its earlier outputs were read
+    stopped: list = field(default_factory=list)  # seeds stopped at the route time limit (notes)
 
 
 def lut_need(res: Result) -> int:

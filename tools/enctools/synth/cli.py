@@ -48,6 +48,8 @@ Options:
   --seeds N          at most N nextpnr seeds per row (seeds 1..N; the seeds column says how many a
                      row had): a first figure of a long row, whose other seeds a later run adds
   --jobs N           parallel tool runs (default 2)
+  --pnr-limit MIN    stop a nextpnr run after MIN minutes (default 60): a seed whose router does
+                     not converge is left out of its row's median, and the row says so
   --quick            one nextpnr seed per row, the multi-channel rows reduced (16 lean channels,
                      per channel and shared engine: 2) or left out (8 full on the ECP5, the other
                      engine rows), no channel table (CI: checks the flow, not the figures; no
@@ -71,7 +73,7 @@ import time
 
 from .. import core as core_file
 from ..paths import TOP
-from .blocks import BLOCKS, BUILD, CHANNELS_MD, RESULTS_MD, SEED, WAIVERS, Block, Result
+from .blocks import BLOCKS, BUILD, CHANNELS_MD, PNR_LIMIT_MIN, RESULTS_MD, SEED, WAIVERS, Block, Result
 from .build import Waiver, load_waivers, merge_seeds, seed_run, synthesize
 from .channels import SWEEP_CHANNELS, channel_table, channels_markdown, sweep_blocks
 from .report import changes, efifo_table, kept_rows, markdown, previous_rows, table
@@ -112,7 +114,8 @@ def took(reused: bool, seconds: float) -> str:
     return "inputs unchanged: earlier run reused" if reused else f"{seconds:.0f} s"
 
 
-def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers: int) -> dict[str, Result]:
+def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers: int,
+             limit_min: float | None = None) -> dict[str, Result]:
     """Every build once on `workers` threads. Yosys runs first for the builds that get placed,
     then each of their nextpnr seeds is a job of its own (so the seeds of a long row run side by
     side), then the synthesis-only builds; the largest first within each. A progress line as each
@@ -132,7 +135,7 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
                 return
             t0 = time.monotonic()
             try:
-                out = synthesize(b, results[b.key], waivers) if kind == "synth" else seed_run(b, seed, bitstream)
+                out = synthesize(b, results[b.key], waivers) if kind == "synth" else seed_run(b, seed, bitstream, limit_min)
             except BaseException as e:  # raised again in the main thread
                 out = e
             finished.put((kind, b, seed, out, time.monotonic() - t0))
@@ -171,7 +174,7 @@ def run_jobs(jobs: list[Block], waivers: list[Waiver], bitstream: bool, workers:
             merge_seeds(r, runs[b.key])
         if r.status == "ok":
             fm = (f"{r.fmax:.1f} MHz" if r.fmax is not None else "synthesis only" if not b.pnr else
-                  "does not fit" if not r.fits else "no clock")
+                  "does not fit" if not r.fits else "not routed" if r.stopped else "no clock")
             print(f"{head} {r.luts:5d} LUT4 {r.ffs:5d} FF {r.carries:4d} carry  {fm:>14s}"
                   f"  ({r.seconds:.0f} s{', synthesis reused' if r.reused else ''})"
                   f"{'  FAIL' if r.failures else ''}", flush=True)
@@ -196,6 +199,9 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, metavar="N",
                     help="at most N nextpnr seeds per row (a row's seeds column says how many it had)")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("JOBS", "2") or 2))
+    ap.add_argument("--pnr-limit", type=float, default=PNR_LIMIT_MIN, metavar="MIN",
+                    help=f"stop a nextpnr run after MIN minutes (default {PNR_LIMIT_MIN:g}): a seed "
+                         "whose router does not converge is left out of the median, and its row says so")
     ap.add_argument("--quick", action="store_true",
                     help="one nextpnr seed per row, multi-channel rows reduced or left out, no channel "
                          "table; no table file rewritten")
@@ -206,6 +212,8 @@ def main() -> int:
     args = ap.parse_args()
     if args.jobs < 1:
         ap.error(f"--jobs must be at least 1, not {args.jobs}")
+    if not args.pnr_limit > 0:
+        ap.error(f"--pnr-limit must be more than 0 minutes, not {args.pnr_limit:g}")
     picked = args.only or args.param
     if picked and args.table in ("both", "channels"):
         ap.error("--only and --param pick rows of the first table; the channel table runs without them "
@@ -245,7 +253,7 @@ def main() -> int:
     waivers = load_waivers()
     before = previous_rows(RESULTS_MD)
     t0 = time.monotonic()
-    results = run_jobs(jobs, waivers, args.bitstream, args.jobs)
+    results = run_jobs(jobs, waivers, args.bitstream, args.jobs, args.pnr_limit)
     ordered = [results[b.key] for b in blocks]
     write = not picked and not args.quick
     if blocks:

@@ -30,6 +30,8 @@ def goal_cells(r: Result) -> tuple[str, str]:
         goals.append(f"≥ {b.fmax_goal:g} MHz")
         if r.status == "ok" and not r.fits:
             verdicts.append("**missed: does not fit the part**")
+        elif r.status == "ok" and r.fmax is None and r.stopped:
+            verdicts.append("**missed: not routed in time**")
         elif r.status == "ok" and r.fmax is not None:
             short = b.fmax_goal - r.fmax
             verdicts.append("met" if short <= 0 else f"**missed by {short:.1f} MHz**")
@@ -74,6 +76,10 @@ def table(results: list[Result | dict]) -> str:
             continue
         fmax = (f"{r.fmax:.1f}" if r.fmax is not None else
                 "not placed (does not fit)" if not r.fits else "n/a (no clocked path)")
+        if r.stopped and r.fmax is None:
+            fmax = f"not routed ({'; '.join(r.stopped)})"
+        elif r.stopped:
+            fmax += f" (median of {b.seeds - len(r.stopped)}; {'; '.join(r.stopped)})"
         goal, verdict = goal_cells(r)
         if r.dsps:
             verdict += f"; {r.dsps} SB_MAC16"
@@ -123,7 +129,8 @@ def markdown(results: list[Result | dict], efifo: list[str] | None = None) -> st
         f"ECP5 rows: `synth_ecp5` + nextpnr-ecp5, {ECP5_DEVICE_NAME}. "
         "LUT4 = SB_LUT4 (iCE40) or LUT4 (ECP5) cells after synthesis (carry-chain LUTs included on "
         "iCE40), FF = SB_DFF* / TRELLIS_FF cells, carry = SB_CARRY / CCU2C. Fmax: median over the "
-        "seeds shown. Block RAM: SB_RAM40_4K / DP16KD cells, and the ECP5's distributed RAM "
+        "seeds shown (a seed whose nextpnr run was stopped at the route time limit, --pnr-limit, "
+        "is left out, and the cell names it). Block RAM: SB_RAM40_4K / DP16KD cells, and the ECP5's distributed RAM "
         "(TRELLIS_DPR16X4, 16 x 4 bits in the LUTs of a slice, not in the LUT4 column). Placed: the "
         "LUT4 sites nextpnr used after packing (iCE40 logic cells, ECP5 TRELLIS_COMB: LUT4, carry "
         "and distributed RAM) of the part's. A build with more LUT4, flip-flops or block RAMs than "
