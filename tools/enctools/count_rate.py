@@ -107,6 +107,12 @@ def main() -> int:
     t0 = time.time()
     duts = {"both": ["probe", "qei"], "all": list(DUTS)}.get(args.dut, [args.dut])
 
+    def walks_at(dut: str, f: int, s: float) -> tuple[list[dict], list[dict]]:
+        """Every seed's walk at states of S clocks: the results, and the misses nothing flagged."""
+        results = run_points(dut, f, [{"s": s, "n": args.transitions, "seed": args.seed * f + k}
+                                      for k in range(args.seeds)])
+        return results, [r for r in results if not r["exact"] and not r["flagged"]]
+
     def one_filter(job):
         dut, f = job
         bound = max(1.0, f / 2)
@@ -114,10 +120,8 @@ def main() -> int:
         failed_at = None
         for ratio in RATIOS:
             s = round(bound * ratio, 4)
-            points = [{"s": s, "n": args.transitions, "seed": args.seed * f + k} for k in range(args.seeds)]
-            results = run_points(dut, f, points)
+            results, silent = walks_at(dut, f, s)
             exact = all(r["exact"] for r in results)
-            silent = [r for r in results if not r["exact"] and not r["flagged"]]
             walks = f"{args.seeds} x {ENGINE_CHANNELS}" if dut == "engine" else f"{args.seeds}"
             print(f"count_rate: {dut} F={f} S={s:.3f} clocks ({ratio:.2f} x bound): "
                   f"{'exact' if exact else 'NOT exact'} over {walks} x {args.transitions} transitions"
@@ -130,10 +134,8 @@ def main() -> int:
             smallest_exact = s
         # well below the bound: how many walks miss, and that each one that does is flagged
         s = round(bound * FLAG_RATIO, 4)
-        results = run_points(dut, f, [{"s": s, "n": args.transitions, "seed": args.seed * f + k}
-                                      for k in range(args.seeds)])
+        results, silent = walks_at(dut, f, s)
         inexact = [r for r in results if not r["exact"]]
-        silent = [r for r in inexact if not r["flagged"]]
         print(f"count_rate: {dut} F={f} S={s:.3f} clocks ({FLAG_RATIO:.2f} x bound): "
               f"{len(inexact)} of {len(results)} walks inexact, {len(inexact) - len(silent)} of them "
               f"flagged  [{time.time() - t0:.0f} s]", flush=True)

@@ -191,23 +191,26 @@ class LaneParts:
     rec_w: int     # its record's width
 
 
+def module_of(mods: dict, cell_type: str) -> str | None:
+    """The module of a hierarchical stat a cell type names (a plain module's type lacks the
+    leading backslash of its module's name; a $paramod type is the name itself), or None."""
+    return next((m for m in (cell_type, "\\" + cell_type) if m in mods), None)
+
+
 def module_luts(stat: dict) -> dict[str, int]:
     """LUT4 of each module of a hierarchical stat, submodule instances included, by the module's
     base name (`$paramod...\\enc_qei_lane` -> enc_qei_lane)."""
     mods = stat["modules"]
-    base = {m: m.rsplit("\\", 1)[-1] for m in mods}
-    by_base = {b: m for m, b in base.items()}
     memo: dict[str, int] = {}
 
     def total(m: str) -> int:
         if m not in memo:
             cells = mods[m].get("num_cells_by_type", {})
             memo[m] = cells.get("SB_LUT4", 0) + sum(
-                n * total(by_base[t.lstrip("\\")]) for t, n in cells.items()
-                if t.lstrip("\\") in by_base)
+                n * total(sub) for t, n in cells.items() if (sub := module_of(mods, t)) is not None)
         return memo[m]
 
-    return {base[m]: total(m) for m in mods}
+    return {m.rsplit("\\", 1)[-1]: total(m) for m in mods}
 
 
 def lane_parts() -> LaneParts | None:
@@ -232,7 +235,8 @@ def lane_parts() -> LaneParts | None:
               "the channel table goes without its paragraph")
         return None
     bits = lane["ports"]["rec"]["bits"]
-    n_filters = next((n for t, n in lane_cells.items() if t.lstrip("\\") == "enc_filter_rt"), 0)
+    n_filters = next((n for t, n in lane_cells.items()
+                      if (module_of(got["stat"]["modules"], t) or "").endswith("enc_filter_rt")), 0)
     return LaneParts(lane=luts["enc_qei_lane"], filters=n_filters * luts["enc_filter_rt"],
                      n_filters=n_filters, decode=luts["enc_qei_decode"],
                      rec_bits=sum(isinstance(b, int) for b in bits), rec_w=len(bits))

@@ -74,12 +74,11 @@ def table(results: list[Result | dict]) -> str:
             rows.append(f"| {b.name} | {b.param_text} | {part} | - | - | - | - | {b.seeds} | - | - | "
                         f"{goal_cells(r)[0]} | {r.note} |")
             continue
-        fmax = (f"{r.fmax:.1f}" if r.fmax is not None else
+        stopped = "; ".join(r.stopped)  # seeds stopped at the route time limit
+        fmax = (f"not routed ({stopped})" if r.fmax is None and stopped else
+                f"{r.fmax:.1f} (median of {b.seeds - len(r.stopped)}; {stopped})" if stopped else
+                f"{r.fmax:.1f}" if r.fmax is not None else
                 "not placed (does not fit)" if not r.fits else "n/a (no clocked path)")
-        if r.stopped and r.fmax is None:
-            fmax = f"not routed ({'; '.join(r.stopped)})"
-        elif r.stopped:
-            fmax += f" (median of {b.seeds - len(r.stopped)}; {'; '.join(r.stopped)})"
         goal, verdict = goal_cells(r)
         if r.dsps:
             verdict += f"; {r.dsps} SB_MAC16"
