@@ -20,10 +20,10 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, signed
-from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, begin, engine_build, lacks,
-                              read_snapshot, run_feature)
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, begin, engine_build, engine_period,
+                              lacks, read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import ClockWalk, durations
+from enctools.qei.stimulus import ClockWalk, Timeline, durations
 from enctools.regmap import event_bits, pack
 from enctools.tb import cocotb_test
 
@@ -454,6 +454,64 @@ async def snapshot_deltas_backward(dut):
         assert signed(snap["edge_delta"]) == model.delta, \
             f"after {n} x {way:+d}: SNAP_EDGE_DELTA {signed(snap['edge_delta'])}, model {model.delta}"
         model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def edge_time_across_count_writes(dut):
+    """A COUNT_LO write leaves the filters' FILTER_LEN alone in every clock: FILTER_LEN 3, then
+    COUNT_LO writes, each with one step whose pins change i clocks after the write starts. With
+    the shared engine every write starts at one phase of its visits and i runs over 2 P + 24
+    clocks, so that in one trial the filter takes the step's third sample in the clock before the
+    load (when the engine pushes the channel's configuration for the load), in another in the
+    load's clock, and so on; a per-channel build loads at once (i over 8 clocks). Each trial's
+    SNAP_EDGE_TIME (a snapshot after the load) is the step's clock + Timeline.EDGE_PIPE + 2 (two
+    samples more than FILTER_LEN 1), whatever i."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=rng.getrandbits(16), filter_len=3)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE="any"))
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    tb = dut.u_qei.timebase
+    now = [int(tb.value), int(tb.value)]  # (the timebase unwrapped, its last raw value)
+
+    def unwrapped() -> int:
+        raw = int(tb.value)
+        now[0] += (raw - now[1]) & ts_mask
+        now[1] = raw
+        return now[0]
+
+    p = engine_period(int(dut.CHANNELS.value)) if env.engine else 1
+    span = 2 * p + 24 if env.engine else 8
+    r0 = rng.randrange(p)
+    pipe = Timeline.EDGE_PIPE + 2
+    for i in range(span):
+        while True:  # (the engine's visits and the timebase both start at rst)
+            await FallingEdge(dut.clk)
+            if unwrapped() % p == r0:
+                break
+        at = []
+
+        async def step() -> None:
+            for _ in range(i):
+                await FallingEdge(dut.clk)
+            env.pos += 1
+            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+            at.append(unwrapped())
+
+        task = cocotb.start_soon(step())
+        await bus.wr("COUNT_LO", rng.getrandbits(32))
+        await task
+        await ClockCycles(dut.clk, pipe + 4)
+        await env.applied()
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE="any", CMD=1))
+        await env.settle(4)
+        edge = await bus.rd("SNAP_EDGE_TIME")
+        assert edge == (at[0] + pipe) & ts_mask, \
+            f"step {i} clocks after a COUNT_LO write (pins at timebase {at[0] & ts_mask:#x}): " \
+            f"SNAP_EDGE_TIME {edge:#x}, not {(at[0] + pipe) & ts_mask:#x}"
+        unwrapped()
     await bus.wr("SNAP_CTRL", 0)
 
 
