@@ -64,6 +64,8 @@ module enc_qei_engine_formal #(
   wire                resp_valid, gsnap;
   wire [31:0]         resp_rdata;
   wire [CHANNELS-1:0] irq_pend, cmp_out;
+  wire [CHANNELS-1:0] step_up, step_dn, idx_hit;  // (for edge FIFOs: none here, EFIFO 0)
+  wire [2*CHANNELS-1:0] step_ab;
 
   enc_qei_engine #(
       .CHANNELS(CHANNELS),
@@ -94,7 +96,13 @@ module enc_qei_engine_formal #(
       .gsnap_req (gsnap_req),
       .gsnap     (gsnap),
       .irq_pend  (irq_pend),
-      .cmp_out   (cmp_out)
+      .cmp_out   (cmp_out),
+      .step_up   (step_up),
+      .step_dn   (step_dn),
+      .step_ab   (step_ab),
+      .idx_hit   (idx_hit),
+      .ef_thresh ({CHANNELS{1'b0}}),
+      .ef_ovf    ({CHANNELS{1'b0}})
   );
 
   // ---- probes, connected by the .sby after flatten ------------------------------------------------

@@ -97,6 +97,8 @@ module enc_qei_lane_formal #(
   reg  [WW-1:0]    f_tb;   // the timebase (TS_W bits kept: the wrapper's)
   wire [REC_W-1:0] rec;
   wire             snap_pend, cmp_out;
+  wire             step_up, step_dn, idx_hit;  // (for an edge FIFO: none here, EFIFO 0)
+  wire [1:0]       step_ab;
 
   always @(posedge clk) begin
     if (!f_past) f_tb <= {WW{1'b0}};
@@ -135,7 +137,13 @@ module enc_qei_lane_formal #(
       .rd       (rd),
       .rec      (rec),
       .snap_pend(snap_pend),
-      .cmp_out  (cmp_out)
+      .cmp_out  (cmp_out),
+      .step_up  (step_up),
+      .step_dn  (step_dn),
+      .step_ab  (step_ab),
+      .idx_hit  (idx_hit),
+      .ef_thresh(1'b0),
+      .ef_ovf   (1'b0)
   );
 
   // the engine raises gsnap only when the lane has no capture waiting, or in its read's clock

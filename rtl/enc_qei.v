@@ -30,7 +30,9 @@
 //   ENGINE     0 per_channel: enc_qei_channel x CHANNELS, as above; 1 shared: enc_qei_engine, one
 //              engine that keeps every channel's registers in block RAM and visits them in turn,
 //              with a small lane per channel for what must see every clock (CAPS.ENGINE; the
-//              RDL gives what it shows later, and by how many clocks at most)
+//              RDL gives what it shows later, and by how many clocks at most); with EFIFO_LOG2
+//              > 0 the channels' edge FIFOs sit beside it (enc_qei_efifo_bank, one FIFO per
+//              channel fed by its lane, their EFIFO_* registers answered there)
 //   FUNC_MASK  the count functions built, bit F for CTRL.FUNC value F (default: all). With one
 //              bit set the function is fixed: CTRL.FUNC reads it and ignores writes, and the
 //              decode logic of the others is left out. With several, a CTRL.FUNC value outside
@@ -107,14 +109,6 @@ module enc_qei #(
       $error("enc_qei: PROFILE lean (3) needs COUNT_W of at least 32");
 `endif
     end
-    // (the shared engine has no edge FIFO)
-    if (ENGINE != 0 && EFIFO_LOG2 != 0) begin : g_bad_engine_build
-`ifdef __ICARUS__
-      enc_qei__parameter_ENGINE_1_needs_EFIFO_LOG2_0 u_stop ();
-`else
-      $error("enc_qei: parameter ENGINE = 1 (shared) needs EFIFO_LOG2 = 0 (no edge FIFO)");
-`endif
-    end
     // (the edge FIFO timestamps with the timing unit's timebase)
     if (EFIFO_LOG2 != 0 && TIMING == 0) begin : g_bad_efifo_profile
 `ifdef __ICARUS__
@@ -172,12 +166,17 @@ module enc_qei #(
                         (addr16[7:2] == ENC_QEI_TIMEBASE[7:2]) | (addr16[7:2] == ENC_QEI_TB_PRESCALE[7:2]) |
                         (addr16[7:2] == ENC_QEI_GSNAP_CTRL[7:2]) | (addr16[7:2] == ENC_QEI_GSNAP_PERIOD[7:2]) |
                         (addr16[7:2] == ENC_QEI_GSNAP_TIME[7:2]) | (addr16[7:2] == ENC_QEI_IRQ_SUMMARY[7:2]));
-  wire        to_eng = (ENGINE != 0) & ~is_glb & enc_qei_mapped(addr16, CHANNELS);
-  wire        regs_resp_valid, regs_resp_err, eng_resp_valid;
-  wire [31:0] regs_resp_rdata, eng_resp_rdata;
+  wire        is_ef  = (addr16[7:2] == ENC_QEI_EFIFO_CTRL[7:2]) | (addr16[7:2] == ENC_QEI_EFIFO_STATUS[7:2]) |
+                       (addr16[7:2] == ENC_QEI_EFIFO_ENTRY[7:2]) | (addr16[7:2] == ENC_QEI_EFIFO_TIME[7:2]) |
+                       (addr16[7:2] == ENC_QEI_EFIFO_LOST[7:2]);
+  wire        to_pg  = (ENGINE != 0) & ~is_glb & enc_qei_mapped(addr16, CHANNELS);
+  wire        to_ef  = to_pg & (EFIFO != 0) & is_ef;  // (the engine's edge FIFOs)
+  wire        to_eng = to_pg & ~to_ef;
+  wire        regs_resp_valid, regs_resp_err, eng_resp_valid, ef_resp_valid;
+  wire [31:0] regs_resp_rdata, eng_resp_rdata, ef_resp_rdata;
 
-  assign resp_valid = regs_resp_valid | eng_resp_valid;
-  assign resp_rdata = regs_resp_rdata | eng_resp_rdata;
+  assign resp_valid = regs_resp_valid | eng_resp_valid | ef_resp_valid;
+  assign resp_rdata = regs_resp_rdata | eng_resp_rdata | ef_resp_rdata;
   assign resp_err   = regs_resp_err;
 
   enc_qei_regs #(
@@ -195,7 +194,7 @@ module enc_qei #(
   ) u_regs (
       .clk       (clk),
       .rst       (rst),
-      .req_valid (req_valid & ~to_eng),
+      .req_valid (req_valid & ~to_pg),
       .req_write (req_write),
       .req_addr  (req_addr),
       .req_wdata (req_wdata),
@@ -288,6 +287,9 @@ module enc_qei #(
     if (ENGINE == 0) begin : g_per_channel
       assign gsnap          = gsnap_req;
       assign eng_resp_valid = 1'b0;
+      assign ef_resp_valid  = 1'b0;
+      assign ef_resp_rdata  = 32'd0;
+      wire unused_to_eng    = &{1'b0, to_eng};
       assign eng_resp_rdata = 32'd0;
 
       for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
@@ -319,6 +321,9 @@ module enc_qei #(
         );
       end
     end else begin : g_engine
+      wire [CHANNELS-1:0]   step_up, step_dn, idx_hit, ef_thresh, ef_ovf;
+      wire [2*CHANNELS-1:0] step_ab;
+
       // (the channel pages are the engine's: the register block has none)
       wire unused_pages = &{1'b0, reg2hw_ch};
       for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_no_page
@@ -334,7 +339,8 @@ module enc_qei #(
           .TIMING    (TIMING),
           .RANGE     (RANGE),
           .PROBE     (PROBE),
-          .PERIOD    (PERIOD)
+          .PERIOD    (PERIOD),
+          .EFIFO     (EFIFO)
       ) u_engine (
           .clk       (clk),
           .rst       (rst),
@@ -356,8 +362,47 @@ module enc_qei #(
           .gsnap_req (gsnap_req),
           .gsnap     (gsnap),
           .irq_pend  (irq_pend),
-          .cmp_out   (cmp_out)
+          .cmp_out   (cmp_out),
+          .step_up   (step_up),
+          .step_dn   (step_dn),
+          .step_ab   (step_ab),
+          .idx_hit   (idx_hit),
+          .ef_thresh (ef_thresh),
+          .ef_ovf    (ef_ovf)
       );
+
+      // the edge FIFOs: one per channel, beside the engine (their registers are answered there)
+      if (EFIFO != 0) begin : g_efifo
+        enc_qei_efifo_bank #(
+            .CHANNELS  (CHANNELS),
+            .DEPTH_LOG2(EFIFO_LOG2),
+            .TS_W      (TS_W)
+        ) u_efifo_bank (
+            .clk       (clk),
+            .rst       (rst),
+            .timebase  (timebase),
+            .req_valid (req_valid & to_ef),
+            .req_write (req_write),
+            .req_ch    (addr16[11:8]),
+            .req_word  (addr16[7:2]),
+            .req_wdata (req_wdata),
+            .req_wstrb (req_wstrb),
+            .resp_valid(ef_resp_valid),
+            .resp_rdata(ef_resp_rdata),
+            .step_up   (step_up),
+            .step_dn   (step_dn),
+            .step_ab   (step_ab),
+            .idx_hit   (idx_hit),
+            .ev_thresh (ef_thresh),
+            .ev_ovf    (ef_ovf)
+        );
+      end else begin : g_no_efifo
+        wire unused_steps = &{1'b0, step_up, step_dn, step_ab, idx_hit};
+        assign ef_thresh     = {CHANNELS{1'b0}};
+        assign ef_ovf        = {CHANNELS{1'b0}};
+        assign ef_resp_valid = 1'b0;
+        assign ef_resp_rdata = 32'd0;
+      end
     end
   endgenerate
 

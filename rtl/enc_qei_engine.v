@@ -38,6 +38,10 @@
 // channel's memory through that channel's write slot), which COUNT_HI reads.
 // After rst every channel's words are the registers' reset values: the first visit of each
 // channel writes them (and the bus reads them until then).
+// Edge FIFOs (EFIFO = 1): not here. enc_qei puts one per channel beside the engine
+// (enc_qei_efifo_bank) and answers their registers there; the engine hands it the lanes' steps
+// (step_up, step_dn, step_ab, idx_hit: each lane's decode, in the clock of the step) and takes
+// the FIFOs' events back through the lanes (EVENTS.EFIFO_THRESH, EFIFO_OVF: R_EFT, R_EFO).
 `default_nettype none
 `include "enc_params.vh"
 `include "enc_qei_lane_w.vh"
@@ -51,7 +55,8 @@ module enc_qei_engine #(
     parameter integer TIMING     = 1,   // units, as enc_qei_regs's (from enc_qei's PROFILE)
     parameter integer RANGE      = 0,
     parameter integer PROBE      = 0,
-    parameter integer PERIOD     = 0
+    parameter integer PERIOD     = 0,
+    parameter integer EFIFO      = 0    // 1: every channel has an edge FIFO (enc_qei_efifo_bank)
 ) (
     input  wire                clk,
     input  wire                rst,        // synchronous, active high
@@ -76,7 +81,14 @@ module enc_qei_engine #(
     input  wire                gsnap_req,  // a global snapshot is requested in this clock
     output wire                gsnap,      // ... taken in this clock (every lane, GSNAP_TIME)
     output wire [CHANNELS-1:0] irq_pend,   // channel k has an enabled pending event
-    output wire [CHANNELS-1:0] cmp_out     // channel k's compare match (its lane's)
+    output wire [CHANNELS-1:0] cmp_out,    // channel k's compare match (its lane's)
+    // the channels' edge FIFOs (EFIFO = 1): the lanes' steps, the FIFOs' events (EVENTS)
+    output wire [CHANNELS-1:0]   step_up,    // channel k steps up in this clock
+    output wire [CHANNELS-1:0]   step_dn,    // ... down
+    output wire [2*CHANNELS-1:0] step_ab,    // ... {A, B} after the step at [2k +: 2]
+    output wire [CHANNELS-1:0]   idx_hit,    // channel k's qualified index edge (with the steps)
+    input  wire [CHANNELS-1:0]   ef_thresh,  // channel k's FIFO holds THRESH entries or more
+    input  wire [CHANNELS-1:0]   ef_ovf      // channel k's FIFO lost a step
 );
 
   `include "enc_qei_regs.vh"
@@ -157,7 +169,8 @@ module enc_qei_engine #(
           .TIMING(TIMING),
           .RANGE (RANGE),
           .PROBE (PROBE),
-          .PERIOD(PERIOD)
+          .PERIOD(PERIOD),
+          .EFIFO (EFIFO)
       ) u_lane (
           .clk      (clk),
           .rst      (rst),
@@ -182,7 +195,13 @@ module enc_qei_engine #(
           .rd       (rd_q[k]),
           .rec      (recs[k*REC_W +: REC_W]),
           .snap_pend(snap_pend[k]),
-          .cmp_out  (cmp_out[k])
+          .cmp_out  (cmp_out[k]),
+          .step_up  (step_up[k]),
+          .step_dn  (step_dn[k]),
+          .step_ab  (step_ab[2*k +: 2]),
+          .idx_hit  (idx_hit[k]),
+          .ef_thresh(ef_thresh[k]),
+          .ef_ovf   (ef_ovf[k])
       );
     end
   endgenerate
@@ -1042,7 +1061,8 @@ module enc_qei_engine #(
   assign ev_new[ENC_QEI_EVENTS_SNAP_READY]   = x_spend;
   assign ev_new[ENC_QEI_EVENTS_PERIOD_READY] = pnb;
   assign ev_new[ENC_QEI_EVENTS_PERIOD_OVF]   = ev_pover;
-  assign ev_new[13:12]                       = 2'd0;
+  assign ev_new[ENC_QEI_EVENTS_EFIFO_THRESH] = rec_q[R_EFT];
+  assign ev_new[ENC_QEI_EVENTS_EFIFO_OVF]    = rec_q[R_EFO];
 
   // (a clear acts on the events the bus could read, the window's new ones stay)
   wire [13:0] events_n = (o_evt[13:0] & ~(w_events ? w_mask[13:0] & w_data[13:0] : 14'd0)) | ev_new;

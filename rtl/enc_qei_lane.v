@@ -55,7 +55,9 @@ module enc_qei_lane #(
     parameter integer TIMING = 1,  // 1: snapshots and edge times
     parameter integer RANGE  = 0,  // 1: ranges and compare
     parameter integer PROBE  = 0,  // 1: the probe latch
-    parameter integer PERIOD = 0   // 1: period capture, stall detection and the unit timer
+    parameter integer PERIOD = 0,  // 1: period capture, stall detection and the unit timer
+    parameter integer EFIFO  = 0   // 1: the channel has an edge FIFO (beside the engine): its steps
+                                   // out, its events in
 ) (
     input  wire             clk,
     input  wire             rst,        // synchronous, active high
@@ -82,7 +84,16 @@ module enc_qei_lane #(
     // to the engine
     output wire [`ENC_QEI_LANE_REC_W(MOT_W, TIM_W, ERR_W)-1:0] rec,  // 0 but with rd
     output wire             snap_pend,  // a snapshot capture waits to be read
-    output wire             cmp_out     // one clock when the count changes to COMPARE (CMP_EN)
+    output wire             cmp_out,    // one clock when the count changes to COMPARE (CMP_EN)
+    // the channel's edge FIFO (enc_qei_efifo, EFIFO = 1; enc_qei_efifo_bank): the count
+    // function's steps in the clock of the step, as enc_qei_core gives them to the per-channel
+    // build's FIFO, and the FIFO's events
+    output wire             step_up,    // a step up (while CTRL.EN = 1)
+    output wire             step_dn,    // ... a step down
+    output wire [1:0]       step_ab,    // ... {A, B} after it
+    output wire             idx_hit,    // a qualified index edge, aligned with the steps
+    input  wire             ef_thresh,  // the FIFO holds EFIFO_CTRL.THRESH entries or more
+    input  wire             ef_ovf      // a step was lost to the full FIFO
 );
 
   `include "enc_qei_regs.vh"
@@ -202,9 +213,8 @@ module enc_qei_lane #(
     end
   end
 
-  wire a_eff, b_eff, z_eff, unused_fdn, step_up, step_dn, edge_any, edge_a_rise, qerr;
-  wire idx_hit, unused_idx_hit1;
-  wire [1:0] unused_step_ab;
+  wire a_eff, b_eff, z_eff, unused_fdn, edge_any, edge_a_rise, qerr;
+  wire unused_idx_hit1;
 
   enc_qei_decode u_dec (
       .clk        (clk),
@@ -231,13 +241,13 @@ module enc_qei_lane #(
       .step_dn    (step_dn),
       .edge_any   (edge_any),
       .edge_a_rise(edge_a_rise),
-      .step_ab    (unused_step_ab),
+      .step_ab    (step_ab),
       .qerr       (qerr),
       .idx_hit1   (unused_idx_hit1),
       .idx_hit    (idx_hit)
   );
 
-  wire unused_dec = &{1'b0, unused_rej_z, unused_fdn, unused_idx_hit1, unused_step_ab};
+  wire unused_dec = &{1'b0, unused_rej_z, unused_fdn, unused_idx_hit1};
 
   // ---- motion, index, direction ------------------------------------------------------------------
   reg  [MOT_W-1:0] mpos_q;
@@ -610,6 +620,32 @@ module enc_qei_lane #(
     end
   end
 
+  // the edge FIFO's events of the window (EFIFO_THRESH: some clock of the window had the level)
+  wire eeft, eefo;
+
+  generate
+    if (EFIFO != 0) begin : g_efifo_ev
+      reg eeft_q, eefo_q;
+
+      always @(posedge clk) begin
+        if (rst) begin
+          eeft_q <= 1'b0;
+          eefo_q <= 1'b0;
+        end else begin
+          eeft_q <= ef_thresh | (eeft_q & ~rd);
+          eefo_q <= ef_ovf | (eefo_q & ~rd);
+        end
+      end
+
+      assign eeft = eeft_q;
+      assign eefo = eefo_q;
+    end else begin : g_no_efifo_ev
+      wire unused_ef = &{1'b0, ef_thresh, ef_ovf};
+      assign eeft = 1'b0;
+      assign eefo = 1'b0;
+    end
+  endgenerate
+
   // ---- probe latch (PROBE) ------------------------------------------------------------------------
   wire             ppend, pen_now;
   wire [MOT_W-1:0] plo;
@@ -799,6 +835,8 @@ module enc_qei_lane #(
   assign rec_d[R_IDX]                  = eidx_q;
   assign rec_d[R_DCH]                  = edch_q;
   assign rec_d[R_CMP]                  = ecmp_q;
+  assign rec_d[R_EFT]                  = eeft;
+  assign rec_d[R_EFO]                  = eefo;
   assign rec_d[R_QCNT +: R_QCNT_W]     = qcnt_q;
   assign rec_d[R_GCNT +: R_GCNT_W]     = gcnt_q;
   assign rec_d[R_A]                    = a_eff;

@@ -22,7 +22,8 @@
 //             R_SEDGE a selected edge in the snapshot's own clock (then R_STIME, R_SMPOS)
 //   R_ET, R_EMP, R_ENEW   the last selected edge (SNAP_CTRL.EDGE) and whether it is in the window
 //   R_OVF, R_UNF, R_IDX, R_DCH, R_CMP   events of the window: overflow, underflow, a qualified
-//             index edge (armed or not), a direction change, a compare match
+//             index edge (armed or not), a direction change, a compare match; R_EFT, R_EFO the
+//             edge FIFO's (EFIFO_THRESH, EFIFO_OVF: a channel with a FIFO)
 //   R_QCNT, R_GCNT   free-running counts of quadrature errors and of rejected levels
 //   R_A, R_B, R_Z, R_DIR, R_ARMED, R_STOPPED   the STATUS bits now; R_ARM INDEX_CTRL.ARM now
 //   R_PPEND, R_PLO, R_PANC, R_PTIME   a probe latch in the window: lo, its anchor, the timebase's
@@ -64,7 +65,9 @@ localparam integer R_UNF     = R_OVF + 1;
 localparam integer R_IDX     = R_UNF + 1;
 localparam integer R_DCH     = R_IDX + 1;
 localparam integer R_CMP     = R_DCH + 1;
-localparam integer R_QCNT    = R_CMP + 1,         R_QCNT_W  = ERR_W;
+localparam integer R_EFT     = R_CMP + 1;
+localparam integer R_EFO     = R_EFT + 1;
+localparam integer R_QCNT    = R_EFO + 1,         R_QCNT_W  = ERR_W;
 localparam integer R_GCNT    = R_QCNT + ERR_W,    R_GCNT_W  = ERR_W;
 localparam integer R_A       = R_GCNT + ERR_W;
 localparam integer R_B       = R_A + 1;

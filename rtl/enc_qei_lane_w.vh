@@ -5,5 +5,5 @@
 `ifndef ENC_QEI_LANE_W_VH
 `define ENC_QEI_LANE_W_VH
 `define ENC_QEI_LANE_CFG_W(MOT, TIM) (3 * (MOT) + 3 * (TIM) + 64)
-`define ENC_QEI_LANE_REC_W(MOT, TIM, ERR) (8 * (MOT) + 10 * (TIM) + 2 * (ERR) + 37)
+`define ENC_QEI_LANE_REC_W(MOT, TIM, ERR) (8 * (MOT) + 10 * (TIM) + 2 * (ERR) + 39)
 `endif

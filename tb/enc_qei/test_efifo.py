@@ -32,8 +32,9 @@ from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import enum, event_bits, get_field, pack
 from enctools.tb import cocotb_test
 
-# (top, CHANNELS, PROFILE, COUNT_W, TS_W, EFIFO_LOG2)
-EFIFO_CONFIGS = (("enc_qei_wb", 1, "full", 32, 32, 4), ("enc_qei_axil", 2, "lean", 32, 16, 5))
+# (top, CHANNELS, PROFILE, COUNT_W, TS_W, EFIFO_LOG2, ENGINE)
+EFIFO_CONFIGS = (("enc_qei_wb", 1, "full", 32, 32, 4, 0), ("enc_qei_axil", 2, "lean", 32, 16, 5, 0),
+                 ("enc_qei_wb", 1, "full", 32, 32, 4, 1), ("enc_qei_axil", 3, "lean", 32, 16, 5, 1))
 
 
 def entry_fields(word: int) -> dict:
@@ -163,6 +164,8 @@ async def entries_match_the_walk(dut):
         await ClockCycles(dut.clk, 12)
         assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == len(steps)
         await fifo.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await fifo.env.applied()
+        await fifo.env.settle(0)
         edge_time = await fifo.bus.rd("SNAP_EDGE_TIME")
         entries = await fifo.drain()
         assert [e["LEFT"] for e in entries] == list(range(len(steps) - 1, -1, -1))
@@ -185,7 +188,7 @@ async def overrun_is_never_silent(dut):
     n = 2 * fifo.depth + 3
     wf, steps = fifo.walk(rng, n, 3, 8)
     await fifo.play(wf)
-    await ClockCycles(dut.clk, 12)
+    await fifo.env.settle()  # (12 clocks, and the shared engine's latency for EVENTS)
     assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == fifo.depth
     lost = await fifo.bus.rd("EFIFO_LOST")
     assert lost == n - fifo.depth, f"EFIFO_LOST {lost}, expected {n - fifo.depth}"
@@ -228,34 +231,44 @@ async def drained_while_counting_at_the_bound(dut):
 async def threshold_event_and_irq(dut):
     """EFIFO_THRESH is set while LEVEL >= THRESH (a clear does not stick until the FIFO is drained
     below it; THRESH 0 acts as 1) and drives irq when enabled; EN = 0 stores nothing; CLEAR empties the FIFO; an
-    empty read pops nothing and leaves EFIFO_TIME alone."""
+    empty read pops nothing and leaves EFIFO_TIME alone. With the shared engine EVENTS and irq
+    follow P + 44 clocks late at most (env.settle waits for that), and a clear acts on what a read
+    could show: a level >= THRESH the register could not show yet at the clear sets the event again
+    once (so each clear here comes a settle after the FIFO changed)."""
     fifo, _, rng = await fifo_of(dut)
+    env = fifo.env
     thresh = 2 * rng.randint(1, fifo.depth // 2 - 1)  # even: a THRESH off by one in bit 0 shows
     # THRESH 0 acts as 1: one entry sets the event
     await fifo.start(thresh=0)
     wf, _ = fifo.walk(rng, 1, 3, 9)
     await fifo.play(wf)
-    await ClockCycles(dut.clk, 12)
+    await env.settle()
     assert "EFIFO_THRESH" in await fifo.bus.events(), "THRESH 0 with one entry"
     await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=0))
+    await env.settle()
     await fifo.bus.events()
+    await env.settle()
     assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False), "THRESH 0, FIFO empty"
     await fifo.start(thresh=thresh)
     await fifo.bus.wr("IRQ_EN", event_bits("EFIFO_THRESH"))
+    await env.applied()
     wf, _ = fifo.walk(rng, thresh - 1, 3, 9)
     await fifo.play(wf)
-    await ClockCycles(dut.clk, 12)
+    await env.settle()
     assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False)
     assert dut.irq.value == 0
     wf, _ = fifo.walk(rng, 1, 3, 9)
     await fifo.play(wf)
-    await ClockCycles(dut.clk, 12)
+    await env.settle()
     assert "EFIFO_THRESH" in await fifo.bus.events()  # (cleared, set again)
+    await env.settle()
     assert "EFIFO_THRESH" in await fifo.bus.events(clear=False), "cleared above THRESH"
     assert dut.irq.value == 1
     e = await fifo.pop()
     time = e["TIME"]
+    await env.settle()
     await fifo.bus.events()
+    await env.settle()
     assert "EFIFO_THRESH" not in await fifo.bus.events(clear=False)
     await ClockCycles(dut.clk, 3)
     assert dut.irq.value == 0
@@ -304,7 +317,7 @@ async def en_off_keeps_lost_forgets_idx(dut):
     await fifo.play(wf)
     a, b = QUAD[fifo.env.pos % 4]
     fifo.env.drv.set_state(a, b, 1)  # an index edge while EN = 0
-    await ClockCycles(dut.clk, 12)
+    await fifo.env.settle()
     assert "INDEX" in await fifo.bus.events(), "the Z edge is an index"
     await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, THRESH=1))
     wf, steps = fifo.walk(rng, 2, 3, 8, p_rev=0.0)
@@ -350,6 +363,7 @@ async def index_marks_its_entry(dut):
     fifo, _, rng = await fifo_of(dut)
     await fifo.start()
     await fifo.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
+    await fifo.env.applied()
     period = rng.choice((12, 16, 20))
 
     def zf(p, n=period):
@@ -417,12 +431,14 @@ async def model_unit_matches_ideal_entries(dut):
 
 
 # ---- pytest --------------------------------------------------------------------------------------
-@pytest.mark.parametrize("top,channels,profile,count_w,ts_w,efifo_log2", EFIFO_CONFIGS,
-                         ids=[f"{t}-ch{c}-{p}-e{e}" for t, c, p, _, _, e in EFIFO_CONFIGS])
-def test_efifo(top, channels, profile, count_w, ts_w, efifo_log2):
+@pytest.mark.parametrize("top,channels,profile,count_w,ts_w,efifo_log2,engine", EFIFO_CONFIGS,
+                         ids=[f"{t}-ch{c}-{p}-e{e}" + ("-engine" if g else "")
+                              for t, c, p, _, _, e, g in EFIFO_CONFIGS])
+def test_efifo(top, channels, profile, count_w, ts_w, efifo_log2, engine):
     from enctools.harness import run
 
     code = enum("CAPS", "PROFILE")[profile]
-    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}_e{efifo_log2}",
+    run(top, __name__, name=f"{build_name(top, count_w, ts_w)}_ch{channels}_{profile}_e{efifo_log2}" +
+        (f"_g{engine}" if engine else ""),
         parameters={"COUNT_W": count_w, "TS_W": ts_w, "CHANNELS": channels, "PROFILE": code,
-                    "EFIFO_LOG2": efifo_log2})
+                    "EFIFO_LOG2": efifo_log2, "ENGINE": engine}, sim="verilator" if engine else None)

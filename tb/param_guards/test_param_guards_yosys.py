@@ -35,7 +35,8 @@ BAD["icebreaker_top"] += [("LINE_HZ", 0, "LINE_HZ"), ("BAUD", 12_000_000, "BAUD"
 # enc_qei's relational limits (as in test_param_guards.RELATIONAL): parameters set together
 BAD_SETS = [(top, params, name) for top in ("enc_qei_wb", "enc_qei_axil") for params, name in (
     ({"CHANNELS": 2, "ADDR_W": 8}, "ADDR_W"), ({"PROFILE": 3, "COUNT_W": 16}, "COUNT_W"),
-    ({"PROFILE": 1, "EFIFO_LOG2": 2}, "EFIFO_LOG2"), ({"ENGINE": 1, "EFIFO_LOG2": 4}, "ENGINE"))]
+    ({"PROFILE": 1, "EFIFO_LOG2": 2}, "EFIFO_LOG2"),
+    ({"ENGINE": 1, "PROFILE": 1, "EFIFO_LOG2": 2}, "EFIFO_LOG2"))]
 
 
 def yosys() -> str:

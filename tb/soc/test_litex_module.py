@@ -60,7 +60,7 @@ def test_edge_fifo_build():
     (dict(efifo_log2=9), ["EFIFO_LOG2", "0 .. 8"]),
     (dict(channels=0), ["CHANNELS", "1 .. 16"]),
     (dict(profile="counting", efifo_log2=4), ["EFIFO_LOG2", "PROFILE"]),
-    (dict(engine=1, efifo_log2=4), ["ENGINE", "EFIFO_LOG2"]),
+    (dict(engine=1, profile="counting", efifo_log2=4), ["EFIFO_LOG2", "PROFILE"]),
     (dict(profile="lean", count_w=16), ["PROFILE", "COUNT_W"]),
     (dict(channels=3, addr_w=9), ["ADDR_W", "CHANNELS"]),
     (dict(profile="medium"), ["profile", "medium"]),

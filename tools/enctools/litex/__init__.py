@@ -99,9 +99,6 @@ def check_params(params: dict) -> dict[str, int]:
     if out.get("EFIFO_LOG2", 0) > 0 and profile == PROFILES["counting"]:
         raise ValueError(f"EncQEI: EFIFO_LOG2 = {out['EFIFO_LOG2']} needs the timing unit, "
                          "PROFILE full or lean (PROFILE is counting)")
-    if out.get("EFIFO_LOG2", 0) > 0 and out.get("ENGINE", 0):
-        raise ValueError(f"EncQEI: ENGINE = 1 (shared) has no edge FIFO: EFIFO_LOG2 must be 0 "
-                         f"(it is {out['EFIFO_LOG2']})")
     return out
 
 

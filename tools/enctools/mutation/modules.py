@@ -108,6 +108,12 @@ MODULES: dict[str, Module] = {
     # enc_qei_ram is not mutated: every engine build instantiates it at two widths (one mutant
     # design cannot serve both), and it is a plain two-port memory the engine's tests read through
     "enc_qei_engine": engine("rtl/enc_qei_engine.v"),
+    # the edge FIFOs beside the engine (ENGINE 1, EFIFO_LOG2 > 0): the edge-FIFO feature file on
+    # its two engine builds (one full channel on Wishbone, three lean on AXI4-Lite)
+    "enc_qei_efifo_bank": Module("rtl/enc_qei_efifo_bank.v", ("tb/enc_qei/test_efifo.py",),
+                                 ("tb/enc_qei/test_efifo.py::*[enc_qei_wb-ch1-full-e4-engine]",
+                                  "tb/enc_qei/test_efifo.py::*[enc_qei_axil-ch3-lean-e5-engine]"),
+                                 suite=ENGINE_SUITE),
     "enc_qei_lane": engine("rtl/enc_qei_lane.v"),
     # shared by both architectures: the per-channel build's feature tests first
     "enc_qei_decode": qei("rtl/enc_qei_decode.v", (WB1,), "func_walks", "swap_and_invert",
