@@ -287,6 +287,54 @@ async def threshold_event_and_irq(dut):
 
 
 @cocotb_test()
+async def registers_byte_enables(dut):
+    """The EFIFO_* registers under byte enables (every mask; non-contiguous ones on Wishbone):
+    EFIFO_CTRL.EN takes lane 0, THRESH lanes 1 (bits 7:0) and 2 (bit 8), the other lanes keep
+    theirs; CLEAR reads 0 and empties the FIFO only when lane 0 is written; a write of EFIFO_LOST
+    with any lane clears it, one with none (Wishbone) keeps it; writes of EFIFO_STATUS,
+    EFIFO_ENTRY and EFIFO_TIME change nothing and pop nothing."""
+    fifo, _, rng = await fifo_of(dut)
+    bus = fifo.bus
+    masks = [1, 2, 4, 8, 3, 6, 12, 7, 14, 15] + ([5, 9, 10, 13, 11] if bus.kind == "wb" else [])
+    await fifo.start()
+    for strb in masks:
+        en, th = rng.getrandbits(1), rng.getrandbits(9)
+        await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=en, THRESH=th))
+        await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1 - en, THRESH=~th & 0x1FF), strb)
+        want_en = 1 - en if strb & 1 else en
+        want_th = ((~th if strb & 2 else th) & 0xFF) | ((~th if strb & 4 else th) & 0x100)
+        got = await bus.rd("EFIFO_CTRL")
+        assert got == pack("EFIFO_CTRL", EN=want_en, THRESH=want_th), \
+            f"EFIFO_CTRL byte enables {strb:#x}: {got:#x}, EN {want_en} THRESH {want_th:#x} expected"
+    # CLEAR acts only with lane 0
+    await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1))
+    wf, _ = fifo.walk(rng, 3, 3, 9)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    level = lambda v: get_field("EFIFO_STATUS", "LEVEL", v)  # noqa: E731
+    for strb in (2, 4, 8, 6, 14):
+        await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1), strb)
+        assert level(await bus.rd("EFIFO_STATUS")) == 3, f"CLEAR with byte enables {strb:#x} emptied the FIFO"
+    # writes of the read-only registers: nothing changes, nothing is popped
+    for reg in ("EFIFO_STATUS", "EFIFO_ENTRY", "EFIFO_TIME"):
+        await bus.wr(reg, rng.getrandbits(32))
+        assert level(await bus.rd("EFIFO_STATUS")) == 3, f"a write of {reg} changed LEVEL"
+    await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1), 1)
+    assert level(await bus.rd("EFIFO_STATUS")) == 0, "CLEAR with lane 0 left entries"
+    assert get_field("EFIFO_CTRL", "CLEAR", await bus.rd("EFIFO_CTRL")) == 0
+    # EFIFO_LOST: any lane clears, none keeps
+    wf, _ = fifo.walk(rng, fifo.depth + 5, 3, 8)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert await bus.rd("EFIFO_LOST") == 5
+    if bus.kind == "wb":
+        await bus.wr("EFIFO_LOST", 0, 0)
+        assert await bus.rd("EFIFO_LOST") == 5, "a write of EFIFO_LOST with no byte enable cleared it"
+    await bus.wr("EFIFO_LOST", 0xFFFFFFFF, rng.choice((1, 2, 4, 8)))
+    assert await bus.rd("EFIFO_LOST") == 0, "a write of EFIFO_LOST with one byte enable kept it"
+
+
+@cocotb_test()
 async def x2a_steps_only(dut):
     """With CTRL.FUNC = x2a only the transitions of A are steps: the entries are exactly those
     steps (direction, state, time), the transitions of B leave no entry."""
