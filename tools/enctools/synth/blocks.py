@@ -115,6 +115,13 @@ BLOCKS = [
           seeds=3, quick=None),
     Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 16, "ENGINE": 1}, device="ecp5",
           seeds=3, quick=None),
+    # ... with an edge FIFO of 16 entries per channel beside the engine (enc_qei_efifo_bank): its
+    # cost is the difference to the 16 lean engine rows. Each FIFO has its own memory: on the
+    # iCE40 3 SB_RAM40_4K a channel (the HX8K has 32), on the ECP5 distributed RAM
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 16, "ENGINE": 1, "EFIFO_LOG2": 4},
+          seeds=3, quick=None),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 16, "ENGINE": 1, "EFIFO_LOG2": 4},
+          device="ecp5", seeds=3, quick=None),
 ]
 
 
