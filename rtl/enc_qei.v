@@ -287,10 +287,10 @@ module enc_qei #(
     if (ENGINE == 0) begin : g_per_channel
       assign gsnap          = gsnap_req;
       assign eng_resp_valid = 1'b0;
+      assign eng_resp_rdata = 32'd0;
       assign ef_resp_valid  = 1'b0;
       assign ef_resp_rdata  = 32'd0;
-      wire unused_to_eng    = &{1'b0, to_eng};
-      assign eng_resp_rdata = 32'd0;
+      wire unused_to_eng    = &{1'b0, to_eng};  // (the register block takes every request)
 
       for (ch = 0; ch < CHANNELS; ch = ch + 1) begin : g_ch
         enc_qei_channel #(

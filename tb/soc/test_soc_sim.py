@@ -13,7 +13,8 @@ register from the wrong channel page, and the same check must fail on it. The ed
 check.check_efifo compares the entries with the model's steps, and must fail on the firmware
 built with FW_FAULT=efifo (an entry's direction from the wrong bit). Two more builds
 (simsoc.ENGINE and simsoc.ENGINE_FULL: lean and full channels sharing one engine) run the same
-firmware. The main and the
+firmware, and simsoc.ENGINE_EFIFO (the edge-FIFO build's channels on the engine) drains its FIFOs
+with the same checks. The main and the
 edge-FIFO builds read one unmapped offset: on VexRiscv it stalls for LiteX's bus timeout and
 reads all ones.
 
@@ -188,6 +189,17 @@ def test_shared_engine_build(cfg, profile):
     assert run.build["engine"] == 1 and run.build["profile"] == profile
     assert run.build["channels"] == cfg.channels
     assert res.ok, res.failures
+
+
+def test_engine_efifo_build():
+    """The edge-FIFO build's channels and motions on the shared engine (its FIFOs beside the
+    engine): the same firmware, the same checks of positions, velocities and FIFO entries."""
+    cfg = simsoc.ENGINE_EFIFO
+    run, res, fifo = _run(cfg=cfg)
+    assert run.done and run.build["engine"] == 1 and run.build["efifo_log2"] == cfg.efifo_log2
+    assert res.ok, res.failures
+    assert fifo.ok, fifo.failures
+    assert all(run.efifo[k]["entries"] > 100 for k in range(cfg.channels)), run.efifo
 
 
 @pytest.mark.parametrize("which", ["main", "efifo"])

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``make soc-sim``: build the simulated LiteX SoCs with enc_qei (simsoc.MAIN, simsoc.EFIFO
 with an edge FIFO per channel, simsoc.ENGINE and simsoc.ENGINE_FULL with lean and full channels
-sharing one engine), run their firmware (on MAIN twice: with the fixed-point and with the double
+sharing one engine, simsoc.ENGINE_EFIFO with edge FIFOs beside the engine), run their firmware (on MAIN twice: with the fixed-point and with the double
 velocity estimator), print the UART tables, check them against the motion model, run the
 deliberately wrong firmware and check that the checks fail, and write doc/results/soc_sim.md
 (the handler's cycles of every build). The pytest module tb/soc/test_soc_sim.py asserts the
@@ -215,6 +215,19 @@ def engine_section(results: dict) -> list[str]:
         lines += ["The engine builds' handler cycles and interrupt latencies are the same to the "
                   "cycle: the firmware makes the same accesses on both profiles, and the engine's "
                   "timing (P, the waits) depends on CHANNELS alone.", ""]
+    cfg, run, res, fifo, _, _ = results["engine_efifo"]
+    b = run.build
+    ok = res.ok and fifo is not None and fifo.ok
+    fails = res.failures + (fifo.failures if fifo else [])
+    lines += [
+        f"**`{cfg.tag}`**: the edge-FIFO build's channels and motions on the engine (CAPS.ENGINE = "
+        f"{b['engine']}, CAPS.EFIFO_LOG2 = {b['efifo_log2']}, {b['channels']} channels; the FIFOs "
+        "sit beside the engine, rtl/enc_qei_efifo_bank.v), the same firmware draining them:",
+        "",
+        *[f"- {s}" for s in res.summary + (fifo.summary if fifo else [])],
+        f"- result: {'pass' if ok else 'FAIL'}" + ("" if ok else ": " + "; ".join(m for _, m in fails[:3])),
+        "",
+    ]
     return lines
 
 
@@ -310,7 +323,8 @@ def write_results(results: dict) -> None:
 # the runs: name -> (build, deliberately wrong firmware its checks must catch, estimator)
 RUNS = {"main": (simsoc.MAIN, "page", "fixed"), "main_double": (simsoc.MAIN, None, "double"),
         "efifo": (simsoc.EFIFO, "efifo", "fixed"), "engine": (simsoc.ENGINE, None, "fixed"),
-        "engine_full": (simsoc.ENGINE_FULL, None, "fixed")}
+        "engine_full": (simsoc.ENGINE_FULL, None, "fixed"),
+        "engine_efifo": (simsoc.ENGINE_EFIFO, None, "fixed")}
 ENGINE_RUNS = ("engine", "engine_full")
 
 

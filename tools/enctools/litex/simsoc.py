@@ -75,11 +75,13 @@ class SocConfig:
 # the builds `make soc-sim` runs: the 4 motions without an edge FIFO; an edge-FIFO build whose
 # firmware drains every channel's FIFO (without the steady channel's 3.1 million steps per
 # second, which no firmware on this CPU could drain: doc/litex.md); the 4 motions on lean and on
-# full channels that share one engine
+# full channels that share one engine; the edge-FIFO build's channels and motions on the engine
+# (its FIFOs beside the engine)
 MAIN = SocConfig()
 EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
 ENGINE = SocConfig(profile="lean", engine=1)
 ENGINE_FULL = SocConfig(profile="full", engine=1)
+ENGINE_EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"), engine=1)
 
 
 def _log(msg: str) -> None:
