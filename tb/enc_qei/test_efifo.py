@@ -52,9 +52,17 @@ class Fifo:
         self.ts_w = int(dut.TS_W.value)
         self.depth = 1 << int(dut.EFIFO_LOG2.value)
 
+    async def level(self) -> int:
+        """EFIFO_STATUS.LEVEL (the register's other bits must read 0)."""
+        word = await self.bus.rd("EFIFO_STATUS")
+        assert word >> 9 == 0, f"EFIFO_STATUS {word:#x}: bits above LEVEL set"
+        return word
+
     async def pop(self) -> dict | None:
         """One EFIFO_ENTRY read (and EFIFO_TIME when TS_W > 16): the entry, or None if empty."""
-        e = entry_fields(await self.bus.rd("EFIFO_ENTRY"))
+        word = await self.bus.rd("EFIFO_ENTRY")
+        assert word & 0xC0 == 0, f"EFIFO_ENTRY {word:#x}: bits 7:6 set"
+        e = entry_fields(word)
         if not e["VALID"]:
             assert all(v == 0 for v in e.values()), f"an empty read answered {e}"
             return None
@@ -83,7 +91,7 @@ class Fifo:
         return model
 
     async def check_empty(self, what: str):
-        assert get_field("EFIFO_STATUS", "LEVEL", await self.bus.rd("EFIFO_STATUS")) == 0, what
+        assert await self.level() == 0, what
         assert await self.bus.rd("EFIFO_ENTRY") == 0, what
         assert await self.bus.rd("EFIFO_TIME") == 0, what
         assert await self.bus.rd("EFIFO_LOST") == 0, what
@@ -164,7 +172,7 @@ async def entries_match_the_walk(dut):
         wf, steps = fifo.walk(rng, fifo.depth - 1, 3, 40)
         await fifo.play(wf)
         await ClockCycles(dut.clk, 12)
-        assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == len(steps)
+        assert await fifo.level() == len(steps)
         await fifo.bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
         await fifo.env.applied()
         await fifo.env.settle(0)
@@ -176,7 +184,7 @@ async def entries_match_the_walk(dut):
             f"last entry at {entries[-1]['TIME']:#x}, SNAP_EDGE_TIME {edge_time:#x}"
         assert await fifo.bus.rd("EFIFO_LOST") == 0
     if len(envs) > 1:
-        assert get_field("EFIFO_STATUS", "LEVEL", await envs[0].bus.rd("EFIFO_STATUS")) == 0
+        assert await Fifo(dut, envs[0]).level() == 0
         assert await envs[0].bus.rd("EFIFO_ENTRY") == 0
 
 
@@ -191,7 +199,7 @@ async def overrun_is_never_silent(dut):
     wf, steps = fifo.walk(rng, n, 3, 8)
     await fifo.play(wf)
     await fifo.env.settle()  # (12 clocks, and the shared engine's latency for EVENTS)
-    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == fifo.depth
+    assert await fifo.level() == fifo.depth
     lost = await fifo.bus.rd("EFIFO_LOST")
     assert lost == n - fifo.depth, f"EFIFO_LOST {lost}, expected {n - fifo.depth}"
     assert "EFIFO_OVF" in await fifo.bus.events()
@@ -279,9 +287,9 @@ async def threshold_event_and_irq(dut):
     wf, _ = fifo.walk(rng, 3, 3, 9)
     await fifo.play(wf)
     await ClockCycles(dut.clk, 12)
-    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == thresh - 1
+    assert await fifo.level() == thresh - 1
     await fifo.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=0, CLEAR=1, THRESH=thresh))
-    assert get_field("EFIFO_STATUS", "LEVEL", await fifo.bus.rd("EFIFO_STATUS")) == 0
+    assert await fifo.level() == 0
     assert await fifo.bus.rd("EFIFO_ENTRY") == 0
     assert await fifo.bus.rd("EFIFO_TIME") == time
 
@@ -311,16 +319,15 @@ async def registers_byte_enables(dut):
     wf, _ = fifo.walk(rng, 3, 3, 9)
     await fifo.play(wf)
     await ClockCycles(dut.clk, 12)
-    level = lambda v: get_field("EFIFO_STATUS", "LEVEL", v)  # noqa: E731
     for strb in (2, 4, 8, 6, 14):
         await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1), strb)
-        assert level(await bus.rd("EFIFO_STATUS")) == 3, f"CLEAR with byte enables {strb:#x} emptied the FIFO"
+        assert await fifo.level() == 3, f"CLEAR with byte enables {strb:#x} emptied the FIFO"
     # writes of the read-only registers: nothing changes, nothing is popped
     for reg in ("EFIFO_STATUS", "EFIFO_ENTRY", "EFIFO_TIME"):
         await bus.wr(reg, rng.getrandbits(32))
-        assert level(await bus.rd("EFIFO_STATUS")) == 3, f"a write of {reg} changed LEVEL"
+        assert await fifo.level() == 3, f"a write of {reg} changed LEVEL"
     await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1), 1)
-    assert level(await bus.rd("EFIFO_STATUS")) == 0, "CLEAR with lane 0 left entries"
+    assert await fifo.level() == 0, "CLEAR with lane 0 left entries"
     assert get_field("EFIFO_CTRL", "CLEAR", await bus.rd("EFIFO_CTRL")) == 0
     # EFIFO_LOST: any lane clears, none keeps
     wf, _ = fifo.walk(rng, fifo.depth + 5, 3, 8)
@@ -332,6 +339,58 @@ async def registers_byte_enables(dut):
         assert await bus.rd("EFIFO_LOST") == 5, "a write of EFIFO_LOST with no byte enable cleared it"
     await bus.wr("EFIFO_LOST", 0xFFFFFFFF, rng.choice((1, 2, 4, 8)))
     assert await bus.rd("EFIFO_LOST") == 0, "a write of EFIFO_LOST with one byte enable kept it"
+
+
+@cocotb_test()
+async def every_channel_its_own(dut):
+    """Every channel's EFIFO_* registers and FIFO are its own: EFIFO_CTRL written on every page
+    with different values, then with each bit the other way, reads back each page's own (read
+    twice, an odd number of clocks apart); then
+    channel k walked k + 1 steps (one channel after the other): every FIFO holds exactly its own
+    channel's steps, in order, at their clocks."""
+    _, rng = await begin(dut)
+    envs = channel_envs(dut, rng, int(dut.CHANNELS.value))
+    fifos = [Fifo(dut, e) for e in envs]
+    values = [(rng.getrandbits(1), rng.getrandbits(9)) for _ in fifos]
+    for rnd in range(2):
+        if rnd:
+            values = [(1 - en, ~th & 0x1FF) for en, th in values]
+        for f, (en, th) in zip(fifos, values):
+            await f.bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=en, THRESH=th))
+        for gap in (0, 1):  # (read at both clock parities: a held value must not toggle)
+            await ClockCycles(dut.clk, gap)
+            for k, (f, (en, th)) in enumerate(zip(fifos, values)):
+                got = await f.bus.rd("EFIFO_CTRL")
+                assert got == pack("EFIFO_CTRL", EN=en, THRESH=th), \
+                    f"channel {k}: EFIFO_CTRL {got:#x} after the writes of every page, wrote EN {en} " \
+                    f"THRESH {th:#x}"
+    for f in fifos:
+        await f.start()
+    walks = []
+    for k, f in enumerate(fifos):
+        wf, steps = f.walk(rng, k + 1, 3, 9)
+        await f.play(wf)
+        walks.append(steps)
+    await ClockCycles(dut.clk, 12)
+    for k, f in enumerate(fifos):
+        assert await f.level() == k + 1, f"channel {k}: LEVEL {await f.level()}, walked {k + 1} steps"
+    for k, f in enumerate(fifos):
+        entries = await f.drain()
+        match(entries, walks[k], f.ts_w, 0, f"channel {k}")
+
+
+@cocotb_test()
+async def lost_counts_past_255(dut):
+    """EFIFO_LOST counts every loss, past 8 bits: the depth plus 300 steps with no reads give
+    EFIFO_LOST = 300 and the FIFO's first depth steps."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    wf, steps = fifo.walk(rng, fifo.depth + 300, 3, 4)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    assert await fifo.bus.rd("EFIFO_LOST") == 300
+    entries = await fifo.drain()
+    match(entries, steps[:fifo.depth], fifo.ts_w, 0, "the stored steps")
 
 
 @cocotb_test()
