@@ -11,7 +11,8 @@
 // with ld, arm_we, pen_we and snap_cmd free at the push. Free at every clock: rst (the first clock
 // is a reset), valid, the pins, snap_in, the timebase's tick, snap_hold, gsnap (raised only when
 // the lane has no capture waiting, or in the clock of its read: the engine's rule).
-// From each record the wrapper rebuilds what the engine rebuilds, with the engine's formulas:
+// From each record the wrapper rebuilds what the engine rebuilds, with the engine's formulas (the
+// engine's own functions lane_sdiff and lane_tstamp, rtl/enc_qei_lane.vh):
 // the motion M += the signed difference of mpos and its value at the read before; the error and
 // glitch counts += the difference of qcnt / gcnt (mod 2^ERR_W); a timestamp = the timebase at the
 // read - (its low bits at the read - the TIM_W bits kept), mod 2^16; a snapshot's motion = M at
@@ -187,23 +188,25 @@ module enc_qei_lane_formal #(
   end
 
   // ---- the engine's view: what it rebuilds at each read -------------------------------------------
+  // (with the engine's own functions, lane_sdiff and lane_tstamp of rtl/enc_qei_lane.vh, kept to
+  // the wrapper's WW bits: the same values mod 2^WW)
   function [WW-1:0] sdiff;  // a - b, MOT_W bits, sign-extended
     input [MOT_W-1:0] a;
     input [MOT_W-1:0] b;
-    reg   [MOT_W-1:0] d;
+    reg   [63:0]      d;
     begin
-      d     = a - b;
-      sdiff = {{(WW - MOT_W){d[MOT_W-1]}}, d};
+      d     = lane_sdiff(a, b);
+      sdiff = d[WW-1:0];
     end
   endfunction
 
   function [WW-1:0] tstamp;  // a timestamp from its low bits, at the timebase now
     input [TIM_W-1:0] t;
     input [WW-1:0]    now;
-    reg   [TIM_W-1:0] age;
+    reg   [31:0]      v;
     begin
-      age    = now[TIM_W-1:0] - t;
-      tstamp = now - {{(WW - TIM_W){1'b0}}, age};
+      v      = lane_tstamp(t, {{(32 - WW){1'b0}}, now});
+      tstamp = v[WW-1:0];
     end
   endfunction
 

@@ -863,26 +863,15 @@ module enc_qei_engine #(
   wire [31:0]      tv = {{(32-TS_W){1'b0}}, tv_q};
   wire [31:0]      vt = o_ud[63:32] & SZ_TS;                 // the read before
 
-  // signed difference of two lane positions, sign-extended to 64 bits
-  function [63:0] sdiff;
-    input [MOT_W-1:0] a;
-    input [MOT_W-1:0] b;
-    reg   [MOT_W-1:0] d;
-    begin
-      d     = a - b;
-      sdiff = {{(64 - MOT_W){d[MOT_W-1]}}, d};
-    end
-  endfunction
-
   // the full timestamp of low bits t, taken at most 2^TIM_W - 1 ticks before now (functions take
-  // every signal they use as an input: a continuous assignment follows only its inputs)
+  // every signal they use as an input: a continuous assignment follows only its inputs). It and
+  // lane_sdiff, the signed difference of two lane positions, are rtl/enc_qei_lane.vh's, which
+  // the lane's proof uses too.
   function [31:0] tstamp;
     input [TIM_W-1:0] t;
     input [31:0]      now;
-    reg   [TIM_W-1:0] age;
     begin
-      age    = now[TIM_W-1:0] - t;
-      tstamp = (now - {{(32 - TIM_W){1'b0}}, age}) & SZ_TS;
+      tstamp = lane_tstamp(t, now) & SZ_TS;
     end
   endfunction
 
@@ -958,7 +947,7 @@ module enc_qei_engine #(
         A_CEIL[1:0]: base = ceil;
         default:     base = cnt;
       endcase
-      rebuild = (base + sdiff(lo, base[MOT_W-1:0])) & SZ_COUNT;
+      rebuild = (base + lane_sdiff(lo, base[MOT_W-1:0])) & SZ_COUNT;
     end
   endfunction
 
@@ -966,10 +955,10 @@ module enc_qei_engine #(
   wire [63:0] cnt_n = rebuild(x_lo, x_anc, w_cnt_lo ? w_val : o_pre, o_ceil, o_cnt);
 
   // the motion, the last selected edge, the snapshot
-  wire [63:0] d_mpos = sdiff(x_mpos, mb);   // the window's motion
-  wire [63:0] d_emp  = sdiff(x_emp, mb);    // ... up to its last selected edge
-  wire [63:0] d_smp  = sdiff(x_smpos, mb);  // ... up to the snapshot
-  wire [63:0] d_semp = sdiff(x_semp, mb);   // ... up to the snapshot's last selected edge
+  wire [63:0] d_mpos = lane_sdiff(x_mpos, mb);   // the window's motion
+  wire [63:0] d_emp  = lane_sdiff(x_emp, mb);    // ... up to its last selected edge
+  wire [63:0] d_smp  = lane_sdiff(x_smpos, mb);  // ... up to the snapshot
+  wire [63:0] d_semp = lane_sdiff(x_semp, mb);   // ... up to the snapshot's last selected edge
   wire [31:0] m_r    = m0 + d_mpos[31:0];
   wire [31:0] te_n   = x_enew ? tstamp(x_et, tv) : o_edge[31:0];
   wire [31:0] me_n   = x_enew ? m0 + d_emp[31:0] : o_edge[63:32];

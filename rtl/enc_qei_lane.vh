@@ -156,3 +156,28 @@ localparam integer C_VSO_LOAD = C_VS_CEIL + VS_W;
 localparam integer C_VSO_CEIL = C_VSO_LOAD + VS_W;
 localparam integer CFG_W      = C_VSO_CEIL + VS_W;  // the configuration's width
 // verilator lint_on UNUSEDPARAM
+
+// How the engine rebuilds wide values from a record (enc_qei_engine's arithmetic; the lane's
+// proof, formal/enc_qei_lane_formal.v, calls the same functions, so it proves these formulas):
+// lane_sdiff, the signed difference a - b of two MOT_W-bit lane positions, sign-extended (a
+// motion since a base, if within +-2^(MOT_W-1)); lane_tstamp, the timestamp whose low TIM_W bits
+// are t, taken at most 2^TIM_W - 1 ticks before the timebase now (the caller masks it to TS_W).
+function [63:0] lane_sdiff;
+  input [MOT_W-1:0] a;
+  input [MOT_W-1:0] b;
+  reg   [MOT_W-1:0] d;
+  begin
+    d          = a - b;
+    lane_sdiff = {{(64 - MOT_W){d[MOT_W-1]}}, d};
+  end
+endfunction
+
+function [31:0] lane_tstamp;
+  input [TIM_W-1:0] t;
+  input [31:0]      now;
+  reg   [TIM_W-1:0] age;
+  begin
+    age         = now[TIM_W-1:0] - t;
+    lane_tstamp = now - {{(32 - TIM_W){1'b0}}, age};
+  end
+endfunction
