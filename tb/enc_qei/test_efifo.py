@@ -345,7 +345,8 @@ async def registers_byte_enables(dut):
 async def every_channel_its_own(dut):
     """Every channel's EFIFO_* registers and FIFO are its own: EFIFO_CTRL written on every page
     with different values, then with each bit the other way, reads back each page's own (read
-    twice, an odd number of clocks apart); then
+    twice, an odd number of clocks apart; EFIFO_LOST 0 without a loss; a read of EFIFO_CTRL
+    right after a write of 0x2 elsewhere empties nothing); then
     channel k walked k + 1 steps (one channel after the other): every FIFO holds exactly its own
     channel's steps, in order, at their clocks."""
     _, rng = await begin(dut)
@@ -373,10 +374,45 @@ async def every_channel_its_own(dut):
         walks.append(steps)
     await ClockCycles(dut.clk, 12)
     for k, f in enumerate(fifos):
+        # (an AXI4-Lite port keeps the last write's data and byte enables: a read of EFIFO_CTRL
+        # after a write of 0x2, CLEAR's bit, with every lane must not clear)
+        assert await f.bus.rd("EFIFO_LOST") == 0, f"channel {k}: EFIFO_LOST without a loss"
+        await f.bus.wr("EFIFO_LOST", pack("EFIFO_CTRL", CLEAR=1))
+        await f.bus.rd("EFIFO_CTRL")
+    for k, f in enumerate(fifos):
         assert await f.level() == k + 1, f"channel {k}: LEVEL {await f.level()}, walked {k + 1} steps"
     for k, f in enumerate(fifos):
         entries = await f.drain()
         match(entries, walks[k], f.ts_w, 0, f"channel {k}")
+
+
+@cocotb_test()
+async def times_on_every_channel(dut):
+    """Every channel's entry times through both registers, over the timebase's low 16 bits: 17
+    rounds 4,096 + 0 .. 63 clocks apart (so bits 12 to 15 of the timebase take each value), each
+    channel one step a round; each entry's EFIFO_ENTRY.TIME_LO equals its EFIFO_TIME's low 16 bits
+    and EFIFO_TIME is the clock of the step, 0 .. 200 ticks before TIMEBASE read after it."""
+    _, rng = await begin(dut)
+    envs = channel_envs(dut, rng, int(dut.CHANNELS.value))
+    fifos = [Fifo(dut, e) for e in envs]
+    mask = (1 << fifos[0].ts_w) - 1
+    for f in fifos:
+        await f.start()
+    for rnd in range(17):
+        plays = []
+        for f in fifos:
+            wf, _ = f.walk(rng, 1, 3, 9, p_rev=0.5)
+            plays.append(cocotb.start_soon(f.play(wf)))
+        for p in plays:
+            await p
+        await ClockCycles(dut.clk, 12)
+        for k, f in enumerate(fifos):
+            e = await f.pop()  # (TIME_LO = EFIFO_TIME's low bits: checked there)
+            now = await f.bus.rd("TIMEBASE")
+            assert e is not None, f"round {rnd}: channel {k} has no entry"
+            age = (now - e["TIME"]) & mask
+            assert age <= 200, f"round {rnd}: channel {k}'s entry at {e['TIME']:#x}, TIMEBASE {now:#x}"
+        await ClockCycles(dut.clk, 4096 + rng.randrange(64))
 
 
 @cocotb_test()
