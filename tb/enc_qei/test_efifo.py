@@ -349,8 +349,7 @@ async def every_channel_its_own(dut):
     right after a write of 0x2 elsewhere empties nothing); then
     channel k walked k + 1 steps (one channel after the other): every FIFO holds exactly its own
     channel's steps, in order, at their clocks."""
-    _, rng = await begin(dut)
-    envs = channel_envs(dut, rng, int(dut.CHANNELS.value))
+    envs, rng = await _start(dut)
     fifos = [Fifo(dut, e) for e in envs]
     values = [(rng.getrandbits(1), rng.getrandbits(9)) for _ in fifos]
     for rnd in range(2):
@@ -392,8 +391,7 @@ async def times_on_every_channel(dut):
     rounds 4,096 + 0 .. 63 clocks apart (so bits 12 to 15 of the timebase take each value), each
     channel one step a round; each entry's EFIFO_ENTRY.TIME_LO equals its EFIFO_TIME's low 16 bits
     and EFIFO_TIME is the clock of the step, 0 .. 200 ticks before TIMEBASE read after it."""
-    _, rng = await begin(dut)
-    envs = channel_envs(dut, rng, int(dut.CHANNELS.value))
+    envs, rng = await _start(dut)
     fifos = [Fifo(dut, e) for e in envs]
     mask = (1 << fifos[0].ts_w) - 1
     for f in fifos:

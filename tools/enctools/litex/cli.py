@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """``make soc-sim``: build the simulated LiteX SoCs with enc_qei (simsoc.MAIN, simsoc.EFIFO
 with an edge FIFO per channel, simsoc.ENGINE and simsoc.ENGINE_FULL with lean and full channels
-sharing one engine, simsoc.ENGINE_EFIFO with edge FIFOs beside the engine), run their firmware (on MAIN twice: with the fixed-point and with the double
-velocity estimator), print the UART tables, check them against the motion model, run the
+sharing one engine, simsoc.ENGINE_EFIFO with edge FIFOs beside the engine), run their firmware
+(on MAIN twice: with the fixed-point and with the double velocity estimator), print the UART tables, check them against the motion model, run the
 deliberately wrong firmware and check that the checks fail, and write doc/results/soc_sim.md
 (the handler's cycles of every build). The pytest module tb/soc/test_soc_sim.py asserts the
 same on the same (cached) runs."""
@@ -217,8 +217,7 @@ def engine_section(results: dict) -> list[str]:
                   "timing (P, the waits) depends on CHANNELS alone.", ""]
     cfg, run, res, fifo, _, _ = results["engine_efifo"]
     b = run.build
-    ok = res.ok and fifo is not None and fifo.ok
-    fails = res.failures + (fifo.failures if fifo else [])
+    ok, fails = verdict(res, fifo)
     lines += [
         f"**`{cfg.tag}`**: the edge-FIFO build's channels and motions on the engine (CAPS.ENGINE = "
         f"{b['engine']}, CAPS.EFIFO_LOG2 = {b['efifo_log2']}, {b['channels']} channels; the FIFOs "

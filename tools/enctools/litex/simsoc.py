@@ -30,7 +30,7 @@ import shutil
 import subprocess
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from .. import core, toolenv
@@ -81,7 +81,7 @@ MAIN = SocConfig()
 EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"))
 ENGINE = SocConfig(profile="lean", engine=1)
 ENGINE_FULL = SocConfig(profile="full", engine=1)
-ENGINE_EFIFO = SocConfig(channels=3, efifo_log2=8, motion_names=("ramp", "reversal", "slow"), engine=1)
+ENGINE_EFIFO = replace(EFIFO, engine=1)
 
 
 def _log(msg: str) -> None:
