@@ -41,6 +41,12 @@ def verdict(res: check.Result, fifo: check.EfifoResult | None) -> tuple[bool, li
     return not fails, fails
 
 
+def result_line(ok: bool, fails: list) -> str:
+    """The "- result:" line of a run: pass, or FAIL with its first three failures."""
+    return f"- result: {'pass' if ok else 'FAIL'}" + ("" if ok else
+                                                      ": " + "; ".join(m for _, m in fails[:3]))
+
+
 def cycles_table(run: check.Run) -> list[str]:
     period = run.build["period"]
     rows = ["| channels read | cycles min | mean | max | the channel's own: min | mean | max | "
@@ -204,8 +210,7 @@ def engine_section(results: dict) -> list[str]:
             f"snapshot ({pc.mean - main.mean:+.0f} and {pc.worst - main.worst:+.0f} against the "
             f"per_channel build `{results['main'][0].tag}`), the fixed part {run.fixed_part[0]} "
             f"to {run.fixed_part[2]}",
-            f"- result: {'pass' if res.ok else 'FAIL'}"
-            + ("" if res.ok else ": " + "; ".join(m for _, m in res.failures[:3])),
+            result_line(res.ok, res.failures),
             "",
             *cycles_table(run),
             "",
@@ -224,7 +229,7 @@ def engine_section(results: dict) -> list[str]:
         "sit beside the engine, rtl/enc_qei_efifo_bank.v), the same firmware draining them:",
         "",
         *[f"- {s}" for s in res.summary + (fifo.summary if fifo else [])],
-        f"- result: {'pass' if ok else 'FAIL'}" + ("" if ok else ": " + "; ".join(m for _, m in fails[:3])),
+        result_line(ok, fails),
         "",
     ]
     return lines
@@ -258,14 +263,12 @@ def write_results(results: dict) -> None:
         "The fixed-point firmware:",
         "",
         *[f"- {s}" for s in res.summary],
-        f"- result: {'pass' if res.ok else 'FAIL'}"
-        + ("" if res.ok else ": " + "; ".join(m for _, m in res.failures[:3])),
+        result_line(res.ok, res.failures),
         "",
         "The double firmware:",
         "",
         *[f"- {s}" for s in dres.summary],
-        f"- result: {'pass' if dres.ok else 'FAIL'}"
-        + ("" if dres.ok else ": " + "; ".join(m for _, m in dres.failures[:3])),
+        result_line(dres.ok, dres.failures),
         "",
     ]
     ecfg, erun, eres, efifo, efault_fails, _ = results["efifo"]
@@ -291,7 +294,7 @@ def write_results(results: dict) -> None:
         f"once per 1 kHz period holds {(1 << eb['efifo_log2']) * 1000:,} steps per second per "
         "channel" if efifo and efifo.cycles_per_entry
         else "- draining: no entries",
-        f"- result: {'pass' if ok else 'FAIL'}" + ("" if ok else ": " + "; ".join(m for _, m in fails[:3])),
+        result_line(ok, fails),
         "",
         *engine_section(results),
         "## Every build",
