@@ -41,7 +41,8 @@ Options:
   --only NAME ...    just these modules' rows of the first table (no channel table; the table
                      file is not rewritten, but see --update)
   --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
-                     shared engine's rows); as --only
+                     shared engine's rows; a row that does not set N has the module's default
+                     from rtl/, so ENGINE=0 picks the per-channel rows); as --only
   --update           with --only or --param: the rows built replace theirs in the table file, the
                      other rows are kept from it as they are (rows of a table with other columns
                      keep the columns they have, "-" for the rest)
@@ -67,6 +68,7 @@ import argparse
 import itertools
 import os
 import queue
+import re
 import sys
 import threading
 import time
@@ -103,6 +105,21 @@ def parse_param(text: str) -> tuple[str, int]:
         return name, int(value)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected NAME=integer, e.g. ENGINE=1, not {text!r}") from None
+
+
+def rtl_default(module: str, name: str) -> int | None:
+    """The default of `parameter integer NAME = <integer>` in rtl/<module>.v, or None (no such
+    file or parameter, or a default that is not a plain integer)."""
+    path = TOP / "rtl" / f"{module}.v"
+    if not path.exists():
+        return None
+    m = re.search(rf"\bparameter\s+integer\s+{re.escape(name)}\s*=\s*(\d+)\s*[,)/]", path.read_text())
+    return int(m.group(1)) if m else None
+
+
+def has_params(b: Block, wanted: list[tuple[str, int]]) -> bool:
+    """`--param`: the row sets each NAME to VALUE, or leaves it at the module's default VALUE."""
+    return all(b.params.get(k, rtl_default(b.name, k)) == v for k, v in wanted)
 
 
 def weight(b: Block) -> int:
@@ -232,7 +249,7 @@ def main() -> int:
             ap.error(f"unknown module(s): {', '.join(sorted(unknown))}")
         blocks = [b for b in BLOCKS if b.name in args.only]
     if args.param:
-        blocks = [b for b in blocks if all(b.params.get(k) == v for k, v in args.param)]
+        blocks = [b for b in blocks if has_params(b, args.param)]
         if not blocks:
             ap.error("no row has " + ", ".join(f"{k}={v}" for k, v in args.param))
     if args.seeds is not None:
