@@ -612,40 +612,14 @@ module enc_qei_engine #(
     end
   endfunction
 
-  // a signed difference of two count values; its magnitude within REACH
-  function near;
-    input [63:0] a;
-    input [63:0] b;
-    reg   [64:0] d;
-    begin
-      d    = {1'b0, a} - {1'b0, b};
-      near = d[64] ? ((~d + 65'd1) <= {1'b0, REACH64}) : (d <= {1'b0, REACH64});
-    end
-  endfunction
-
-  // the same modulo 2^COUNT_W: COMPARE is reached across the end of the range too (the free range
-  // steps from all ones to 0 and back, and a count near 0 may be a few steps from COMPARE = all
-  // ones); equal low bits then still mean an equal count, the count staying within reach of x
-  function near_mod;
-    input [63:0] a;
-    input [63:0] b;
-    reg   [63:0] d;
-    begin
-      d        = (a - b) & SZ_COUNT;
-      near_mod = (d <= REACH64) | (((~d + 64'd1) & SZ_COUNT) <= REACH64);
-    end
-  endfunction
-
-  // the validity set of a count value x, for CEILING c and COMPARE m
+  // the validity set of a count value x, for CEILING c and COMPARE m (lane_vs_of of
+  // rtl/enc_qei_lane.vh, which the lane's count proof calls too)
   function [3:0] vs_of;
     input [63:0] x;
     input [63:0] c;
     input [63:0] m;
     begin
-      vs_of[V_B]  = near_mod(x, 64'd0);  // (0 and all ones: the ends, either way round)
-      vs_of[V_C]  = (RANGE != 0) & near(x, c);
-      vs_of[V_AC] = (RANGE != 0) & (x > c);
-      vs_of[V_P]  = (RANGE != 0) & near_mod(x, m);
+      vs_of = lane_vs_of(x, c, m, SZ_COUNT, REACH64, RANGE != 0);
     end
   endfunction
 
@@ -932,22 +906,16 @@ module enc_qei_engine #(
   wire        w_save   = w_on & (w_off == SAVE_LATCH);
   wire [63:0] w_val    = {o_hi[63:32], w_data} & SZ_COUNT;  // a COUNT_LO write's value (whole)
 
-  // a count from a lane's low bits and their anchor (ld_base: the value of A_LOAD)
+  // a count from a lane's low bits and their anchor (ld_base: the value of A_LOAD): lane_rebuild
+  // of rtl/enc_qei_lane.vh, which the lane's count proof calls too
   function [63:0] rebuild;
     input [MOT_W-1:0] lo;
     input [1:0]       anc;
     input [63:0]      ld_base;  // the value of A_LOAD,
     input [63:0]      ceil;     // ... of A_CEIL,
     input [63:0]      cnt;      // ... of A_NONE
-    reg   [63:0]      base;
     begin
-      case (anc)
-        A_LOAD[1:0]: base = ld_base;
-        A_ZERO[1:0]: base = 64'd0;
-        A_CEIL[1:0]: base = ceil;
-        default:     base = cnt;
-      endcase
-      rebuild = (base + lane_sdiff(lo, base[MOT_W-1:0])) & SZ_COUNT;
+      rebuild = lane_rebuild(lo, anc, ld_base, ceil, cnt, SZ_COUNT);
     end
   endfunction
 

@@ -113,9 +113,10 @@ module enc_qei_lane #(
   // ---- configuration (the registers' reset values until the engine's first push) ---------------
   localparam [4:0] FILT_RST = ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_FILTER_LEN +: 5];
   localparam [7:0] PER_N_RST = ENC_QEI_PERIOD_CTRL_RESET[ENC_QEI_PERIOD_CTRL_N +: 8];
-  // validity sets at reset: the count, PRESET and COMPARE are 0, CEILING is all ones (far from 0)
-  localparam [3:0] VS_RST_0 = 4'b1001;  // 0: at the end of the range, at COMPARE
-  localparam [3:0] VS_RST_C = 4'b0011;  // CEILING: at the end of the range, at CEILING
+  // validity sets at reset: the count, PRESET and COMPARE are 0, CEILING is all ones, one step
+  // from 0 modulo 2^COUNT_W: each is at the end of the range, at CEILING and at COMPARE
+  localparam [3:0] VS_RST_0 = 4'b1011;  // 0
+  localparam [3:0] VS_RST_C = 4'b1011;  // CEILING
   reg  [CFG_W-1:0] cfg_q;
   wire [CFG_W-1:0] cfg_rst;
 
@@ -294,7 +295,15 @@ module enc_qei_lane #(
   wire [MOT_W-1:0] dc     = lo_q - c_lo;
   wire             at_0   = vset[V_B] & (lo_q == {MOT_W{1'b0}});
   wire             at_max = vset[V_B] & (lo_q == {MOT_W{1'b1}});
-  wire             ge_c   = vset[V_C] ? ~dc[MOT_W-1] : vset[V_AC];  // count >= CEILING
+  // count >= CEILING. Near the end of the free range (V_B) the counts in reach may lie on both
+  // sides of it (a count that crossed it since the set was made): lo's top bit tells the side
+  // (set: just below 2^COUNT_W), and CEILING's low bits' top bit CEILING's when it is in reach too
+  // (V_C, modulo 2^COUNT_W); a CEILING out of reach lies between the two sides.
+  wire             lo_hi  = lo_q[MOT_W-1];
+  wire             c_hi   = c_lo[MOT_W-1];
+  wire             ge_c   = (vset[V_B] & vset[V_C] & (lo_hi != c_hi)) ? lo_hi :
+                            vset[V_C] ? ~dc[MOT_W-1] :
+                            vset[V_B] ? lo_hi : vset[V_AC];
   wire             u_step = step_up & ~stop_q;
   wire             d_step = ~step_up & step_dn & ~stop_q;
   wire             up_end = u_step & (r_free ? at_max : ge_c);   // overflow

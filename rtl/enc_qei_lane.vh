@@ -114,8 +114,10 @@ localparam integer REC_W     = R_UD + TIM_W;      // the record's width
 // replaces (an anchor taken before it). Every set is for this configuration's CEILING and
 // COMPARE. A validity set says, for a count near its value, which of these the lane's low bits
 // may stand for: V_B the end of the range (0 / all ones, within reach either way round), V_C
-// CEILING (within reach), V_AC the count is above CEILING (when not V_C), V_P COMPARE (within
-// reach modulo 2^COUNT_W: across the end of the free range too).
+// CEILING (within reach modulo 2^COUNT_W), V_AC the count is above CEILING (used when neither
+// V_B nor V_C), V_P COMPARE (within reach modulo 2^COUNT_W). The counts in reach of a value near
+// the end of the free range (V_B) may lie on both sides of it, so CEILING and COMPARE are taken
+// modulo 2^COUNT_W, and the lane tells the sides apart by the top bit of the low bits.
 localparam integer V_B = 0, V_C = 1, V_AC = 2, V_P = 3, VS_W = 4;
 localparam integer C_EN       = 0;
 localparam integer C_SWAP     = 1;
@@ -179,5 +181,63 @@ function [31:0] lane_tstamp;
   begin
     age         = now[TIM_W-1:0] - t;
     lane_tstamp = now - {{(32 - TIM_W){1'b0}}, age};
+  end
+endfunction
+
+// How the engine rebuilds a count from a lane's low bits lo and their anchor anc (the last since
+// the read before; enc_qei_engine's rebuild, which the lane's count proof calls too): the count
+// within +-2^(MOT_W-1) of the anchor's value whose low bits are lo, kept to the mask sz. The
+// anchor's value: ld_base for A_LOAD (PRESET, or a COUNT write's value), 0 for A_ZERO, ceil for
+// A_CEIL, cnt (the count at the read before) for A_NONE.
+function [63:0] lane_rebuild;
+  input [MOT_W-1:0] lo;
+  input [1:0]       anc;
+  input [63:0]      ld_base;
+  input [63:0]      ceil;
+  input [63:0]      cnt;
+  input [63:0]      sz;
+  reg   [63:0]      base;
+  begin
+    case (anc)
+      A_LOAD[1:0]: base = ld_base;
+      A_ZERO[1:0]: base = 64'd0;
+      A_CEIL[1:0]: base = ceil;
+      default:     base = cnt;
+    endcase
+    lane_rebuild = (base + lane_sdiff(lo, base[MOT_W-1:0])) & sz;
+  end
+endfunction
+
+// How the engine makes a validity set (V_* above) for its pushes (enc_qei_engine's vs_of; the
+// lane's count proof, formal/enc_qei_lane_count_formal.v, calls the same function): lane_vs_of
+// is the set of a count value x for CEILING c and COMPARE m, in a build whose counts are kept to
+// the mask sz (2^COUNT_W - 1), for the counts within reach (the engine's REACH = 2 P + 4 steps)
+// of x. V_B: x within reach of 0 modulo 2^COUNT_W (0 and all ones, the ends of the free range,
+// either way round); V_C: x within reach of c modulo 2^COUNT_W; V_AC: x > c; V_P: x within
+// reach of m modulo 2^COUNT_W. V_C, V_AC and V_P are 0 without ranges (rng 0).
+function lane_near_mod;  // |a - b| <= reach modulo sz + 1
+  input [63:0] a;
+  input [63:0] b;
+  input [63:0] sz;
+  input [63:0] reach;
+  reg   [63:0] d;
+  begin
+    d             = (a - b) & sz;
+    lane_near_mod = (d <= reach) | (((~d + 64'd1) & sz) <= reach);
+  end
+endfunction
+
+function [3:0] lane_vs_of;
+  input [63:0] x;
+  input [63:0] c;
+  input [63:0] m;
+  input [63:0] sz;
+  input [63:0] reach;
+  input        rng;
+  begin
+    lane_vs_of[V_B]  = lane_near_mod(x, 64'd0, sz, reach);
+    lane_vs_of[V_C]  = rng & lane_near_mod(x, c, sz, reach);
+    lane_vs_of[V_AC] = rng & (x > c);
+    lane_vs_of[V_P]  = rng & lane_near_mod(x, m, sz, reach);
   end
 endfunction

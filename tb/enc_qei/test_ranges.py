@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import random
 
+import cocotb
 import pytest
-from hedsmodel import random_walk, walk
+from cocotb.triggers import ClockCycles, FallingEdge
+from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, lacks, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, engine_period, lacks, run_feature
 from enctools.qei.model import RANGES, QeiModel
 from enctools.qei.stimulus import BURST, WIDE, durations, near, slice_compare_cases, steps_from
 from enctools.regmap import get_field, pack, regmap
@@ -251,6 +253,76 @@ async def ceiling_slice_compares(dut):
         for count in counts:
             await steps_from(env, model, count, (+1, -1))
             await env.check(model, f"CEILING {ceiling:#x}, COUNT {count:#x}, +1 -1")
+
+
+@cocotb_test(skip=lacks("RANGE"))
+async def range_change_across_the_wrap(dut):
+    """CTRL.RANGE written from free to limit or modulo (CEILING 1000) while the count crosses the
+    end of the free range: from 2 four steps down and two up, or from all ones - 1 six steps up,
+    3 clocks apart, starting i clocks after the CTRL write starts. With the shared engine every
+    write starts at one phase of its visits and i runs over 2 P + 24 clocks, so the new range is
+    applied before, between and after the steps, in the window right after a crossing too (its
+    range ends then come from a count on the other side of the end); a per-channel build applies
+    it at once (i over 8 clocks). COUNT and EVENTS (DIR_CHANGE aside) must be those of the range
+    changing at one of the seven points between the steps: a count just below 2^COUNT_W is at or
+    above CEILING, one just above 0 below it."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    ceiling = 1000
+    cases = (("limit", 2, (-1, -1, -1, -1, 1, 1)), ("modulo", 2, (-1, -1, -1, -1, 1, 1)),
+             ("limit", -2, (1,) * 6), ("modulo", -2, (1,) * 6))
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    tb = dut.u_qei.timebase
+    now = [int(tb.value), int(tb.value)]  # (the timebase unwrapped, its last raw value)
+
+    def unwrapped() -> int:
+        raw = int(tb.value)
+        now[0] += (raw - now[1]) & ts_mask
+        now[1] = raw
+        return now[0]
+
+    p = engine_period(int(dut.CHANNELS.value)) if env.engine else 1
+    span = 2 * p + 24 if env.engine else 8
+    r0 = rng.randrange(p)
+    for i in range(span):
+        mode, start, steps = cases[i % len(cases)]
+        start &= model.max
+        await env.setup(model, rng_mode="free", filter_len=1, count=start, ceiling=ceiling)
+        unwrapped()
+        while True:  # (the engine's visits and the timebase both start at rst)
+            await FallingEdge(dut.clk)
+            if unwrapped() % p == r0:
+                break
+
+        async def play() -> None:
+            for _ in range(i):
+                await FallingEdge(dut.clk)
+            for s in steps:
+                env.pos += s
+                dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+                await ClockCycles(dut.clk, 3)
+
+        task = cocotb.start_soon(play())
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", RANGE=mode, FILTER_LEN=1))
+        await task
+        await env.settle()
+        await env.applied()
+        got = (await bus.count(), await bus.events() - {"DIR_CHANGE"})
+        outcomes = []
+        for k in range(len(steps) + 1):  # the range changes after step k
+            m = QeiModel(env.count_w)
+            m.count, m.ceiling = start, ceiling
+            for n, s in enumerate(steps):
+                m.range = "free" if n < k else mode
+                m.apply(s)
+            outcomes.append((m.count, m.events - {"DIR_CHANGE"}))
+        assert got in outcomes, \
+            f"{mode} from {start:#x}, steps {steps} {i} clocks after the CTRL write: COUNT {got[0]:#x}, " \
+            f"EVENTS {sorted(got[1])}; the range changing between two steps gives one of " \
+            + ", ".join(f"({c:#x}, {sorted(e)})" for c, e in outcomes)
+        unwrapped()
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1))
 
 
 # ---- pytest ---------------------------------------------------------------------------------------
