@@ -16,7 +16,8 @@
 // rtl/enc_qei_lane.vh, with the engine's REACH): C_VS_CNT for the reference count at the last
 // read, C_VS_LOAD / C_VS_ZERO / C_VS_CEIL for PRESET (a COUNT write's value), 0 and CEILING,
 // C_VSO_LOAD / C_VSO_CEIL for the PRESET and CEILING it replaces, each for the pushed CEILING and
-// COMPARE. Free at every clock: rst (the first clock is a reset), valid, the pins, the index.
+// COMPARE. Free at every clock: rst (the first clock is a reset), valid, the pins, the index, probe_in;
+// PROBE_CTRL.EN and INDEX_CTRL.ARM written at any push.
 //
 // The reference (CW = 16 bits) steps with the lane's decode (step_up / step_dn, the per-channel
 // core's own enc_qei_decode) in the configuration in force: free wraps modulo 2^CW; modulo wraps
@@ -25,18 +26,22 @@
 // OVERFLOW, a down step at 0 UNDERFLOW. A COUNT write loads its value (and releases a stop); an
 // index preset (the lane's qualified index with ARM and ACTION preset) loads PRESET (not
 // releasing a stop). CMP: the clock after the count changed (a step, a wrap or a load) onto
-// COMPARE while CMP_EN = 1.
+// COMPARE while CMP_EN = 1. The index latch (the lane's qualified index with ACTION latch) takes
+// the count after its clock's step, the probe latch (the lane's probe hit) the count in its clock.
 // Proven (k-induction), at every clock: the lane's lo is the reference's low MOT_W bits; its
 // overflow and underflow (up_end, dn_end) and STATUS.STOPPED are the reference's; cmp_out is the
 // reference's CMP; and the count the engine rebuilds from lo and its anchor (lane_rebuild of
 // rtl/enc_qei_lane.vh, enc_qei_engine's formula, with the count at the last read, PRESET or the
 // COUNT write's value, and CEILING as the engine has them stored until it reads the lane) is the
 // reference count: the count the engine stores plus what the lane holds pending is the true
-// count in every clock, and at each read the engine's new count is.
+// count in every clock, and at each read the engine's new count is. An index or probe latch
+// waiting to be read rebuilds (lane_rebuild, with PRESET and CEILING as stored) to the count at
+// its edge.
 // Helpers for the induction (also true): the validity set in force is the engine's set for the
 // value it was made for (the count at the last read or the last anchor since), which the
 // reference is within 2 P + 1 steps of; the lane's configuration fields are the pushed ones.
-// Not here: whether the engine stores what it rebuilds (simulation: test_engine, test_channels).
+// Not here: whether the engine stores what it rebuilds (simulation: test_engine, test_channels),
+// and when the index and probe edges are qualified (the decode's and the probe filter's timing).
 `default_nettype none
 
 module enc_qei_lane_count_formal #(
@@ -47,7 +52,8 @@ module enc_qei_lane_count_formal #(
     input wire valid,
     input wire a_in,
     input wire b_in,
-    input wire z_in
+    input wire z_in,
+    input wire probe_in
 );
 
   // ---- the engine's widths (rtl/enc_qei_engine.v) ---------------------------------------------
@@ -85,7 +91,7 @@ module enc_qei_lane_count_formal #(
   (* anyseq *) reg [CFG_W-1:0] cfg_in;   // the configuration's other fields
   (* anyseq *) reg [CW-1:0]    ceil_in, cmp_in, pre_in, val_in;
   (* anyseq *) reg [1:0]       range_in;
-  (* anyseq *) reg             cmpen_in, cw_in, arm_in;
+  (* anyseq *) reg             cmpen_in, cw_in, arm_in, pen_in;
   always @(*) assume (len_in >= 10'd2 && len_in <= P);
 
   reg  [9:0] cd_q;   // clocks to the next read (0: read in this clock)
@@ -178,7 +184,7 @@ module enc_qei_lane_count_formal #(
       .ERR_W (ERR_W),
       .TIMING(0),
       .RANGE (1),
-      .PROBE (0),
+      .PROBE (1),
       .PERIOD(0)
   ) lane (
       .clk      (clk),
@@ -187,7 +193,7 @@ module enc_qei_lane_count_formal #(
       .a_in     (a_in),
       .b_in     (b_in),
       .z_in     (z_in),
-      .probe_in (1'b0),
+      .probe_in (probe_in),
       .snap_in  (1'b0),
       .tb_lo    ({TIM_W{1'b0}}),
       .tick     (1'b0),
@@ -195,7 +201,7 @@ module enc_qei_lane_count_formal #(
       .snap_hold(1'b0),
       .cfg_we   (push | push1),
       .arm_we   (push & arm_in),
-      .pen_we   (1'b0),
+      .pen_we   (push & pen_in),
       .st_we    (1'b0),
       .u_we     (1'b0),
       .cfg      (cfg),
@@ -224,6 +230,14 @@ module enc_qei_lane_count_formal #(
   (* keep *) wire [3:0]       p_vset;    // lane.vset: the validity set in force
   (* keep *) wire [CFG_W-1:0] p_cfg;     // lane.cfg_q
   (* keep *) wire             p_upd;     // lane.upd_q: the count changed in the clock before
+  (* keep *) wire             p_latch;   // lane.latch: the qualified index latches the count
+  (* keep *) wire [MOT_W-1:0] p_lcap;    // lane.lcap_q: the index latch's low bits
+  (* keep *) wire [1:0]       p_lanc;    // lane.lanc_q: ... their anchor
+  (* keep *) wire             p_lpend;   // lane.lpend_q: an index latch waits to be read
+  (* keep *) wire             p_phit;    // lane.g_probe.phit_q: the probe latches the count
+  (* keep *) wire [MOT_W-1:0] p_plo;     // lane.g_probe.plo_q: the probe latch's low bits
+  (* keep *) wire [1:0]       p_panc;    // lane.g_probe.panc_q: ... their anchor
+  (* keep *) wire             p_ppend;   // lane.g_probe.ppend_q: a probe latch waits to be read
 
   // ---- the reference count --------------------------------------------------------------------------
   reg  [CW-1:0] f_r;      // the count
@@ -287,6 +301,14 @@ module enc_qei_lane_count_formal #(
     end
   end
 
+  // the latches: the index latch takes the count after its clock's step (before a load in that
+  // clock), the probe latch the count in the clock of its hit
+  reg [CW-1:0] f_lat, f_plat;
+  always @(posedge clk) begin
+    if (p_latch) f_lat <= r_st;
+    if (p_phit) f_plat <= f_r;
+  end
+
   // ---- what the validity set in force was made for (helpers for the induction) -------------------
   // f_base: the count at the last read, or the last anchor since (the value the lane's set in
   // force describes); f_dist: a bound on the reference's distance from it; f_ld: the last anchor
@@ -329,6 +351,12 @@ module enc_qei_lane_count_formal #(
   wire [CW-1:0] e_ceil = rd ? f_c0 : f_c;
   wire [63:0]   e_cnt  = lane_rebuild(p_lo, p_anc, {48'd0, e_pre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
 
+  // ... and a latch as the engine rebuilds it (its anchor is never a COUNT write's load: that
+  // comes in the push's clock, after which the read starts a new window)
+  wire [CW-1:0] e_lpre = rd ? f_pr0 : f_pr;
+  wire [63:0]   e_lat  = lane_rebuild(p_lcap, p_lanc, {48'd0, e_lpre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
+  wire [63:0]   e_plat = lane_rebuild(p_plo, p_panc, {48'd0, e_lpre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
+
   // ---- the properties -----------------------------------------------------------------------------
   always @(*) begin
     if (f_past && !rst) begin
@@ -340,6 +368,9 @@ module enc_qei_lane_count_formal #(
       assert (cmp_out == f_cmp_q);
       // stored + pending = the true count
       assert (e_cnt[CW-1:0] == f_r);
+      // a latch waiting to be read: the count at its edge
+      if (p_lpend) assert (e_lat[CW-1:0] == f_lat && p_lcap == f_lat[MOT_W-1:0]);
+      if (p_ppend) assert (e_plat[CW-1:0] == f_plat && p_plo == f_plat[MOT_W-1:0]);
       // helpers
       assert (p_vset == vs(f_base, f_c, f_m));
       assert (f_dist <= P + el_q && wdist(f_r, f_base) <= {6'd0, f_dist});
@@ -364,6 +395,7 @@ module enc_qei_lane_count_formal #(
     if (f_past && !rst) begin
       cover (w0 && f_cen);         // a modulo wrap with compare on
       cover (ld && p_preset);      // a COUNT write's load over an index preset
+      cover (rd && p_lpend && p_lanc != A_NONE[1:0] && p_ppend);  // both latches read, one after an anchor
       cover (f_s && push && rd == 1'b0 && e_up == 1'b0 && f_cmp_q == 1'b0 && f_rg == ENC_QEI_RANGE_FREE);
     end
   end
