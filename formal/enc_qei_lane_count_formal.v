@@ -140,36 +140,27 @@ module enc_qei_lane_count_formal #(
 
   reg [CW-1:0] f_rread;  // the reference count at the last read (the engine's stored count)
 
-  // the configuration pushed: push #1 the one in force with the COUNT write's value; the push
-  // the new one
+  // the configuration pushed: push #1 the one in force with the COUNT write's value (its PRESET
+  // field); the push the new one
+  wire [CW-1:0] q_c   = push1 ? f_c : n_c;
+  wire [CW-1:0] q_m   = push1 ? f_m : n_m;
+  wire [CW-1:0] q_pr  = push1 ? val_in : n_pr;
+  wire [1:0]    q_rg  = push1 ? f_rg : n_rg;
+  wire          q_cen = push1 ? f_cen : n_cen;
   reg [CFG_W-1:0] cfg;
   always @(*) begin
     cfg = cfg_in;
-    if (push1) begin
-      cfg[C_RANGE +: C_RANGE_W] = f_rg;
-      cfg[C_CMP_EN]             = f_cen;
-      cfg[C_PLO +: C_PLO_W]     = val_in[MOT_W-1:0];
-      cfg[C_CLO +: C_CLO_W]     = f_c[MOT_W-1:0];
-      cfg[C_MLO +: C_MLO_W]     = f_m[MOT_W-1:0];
-      cfg[C_VS_CNT +: VS_W]     = vs(f_rread, f_c, f_m);
-      cfg[C_VS_LOAD +: VS_W]    = vs(val_in, f_c, f_m);
-      cfg[C_VS_ZERO +: VS_W]    = vs({CW{1'b0}}, f_c, f_m);
-      cfg[C_VS_CEIL +: VS_W]    = vs(f_c, f_c, f_m);
-      cfg[C_VSO_LOAD +: VS_W]   = vs(f_pr, f_c, f_m);
-      cfg[C_VSO_CEIL +: VS_W]   = vs(f_c, f_c, f_m);
-    end else begin
-      cfg[C_RANGE +: C_RANGE_W] = n_rg;
-      cfg[C_CMP_EN]             = n_cen;
-      cfg[C_PLO +: C_PLO_W]     = n_pr[MOT_W-1:0];
-      cfg[C_CLO +: C_CLO_W]     = n_c[MOT_W-1:0];
-      cfg[C_MLO +: C_MLO_W]     = n_m[MOT_W-1:0];
-      cfg[C_VS_CNT +: VS_W]     = vs(f_rread, n_c, n_m);
-      cfg[C_VS_LOAD +: VS_W]    = vs(n_pr, n_c, n_m);
-      cfg[C_VS_ZERO +: VS_W]    = vs({CW{1'b0}}, n_c, n_m);
-      cfg[C_VS_CEIL +: VS_W]    = vs(n_c, n_c, n_m);
-      cfg[C_VSO_LOAD +: VS_W]   = vs(f_pr, n_c, n_m);
-      cfg[C_VSO_CEIL +: VS_W]   = vs(f_c, n_c, n_m);
-    end
+    cfg[C_RANGE +: C_RANGE_W] = q_rg;
+    cfg[C_CMP_EN]             = q_cen;
+    cfg[C_PLO +: C_PLO_W]     = q_pr[MOT_W-1:0];
+    cfg[C_CLO +: C_CLO_W]     = q_c[MOT_W-1:0];
+    cfg[C_MLO +: C_MLO_W]     = q_m[MOT_W-1:0];
+    cfg[C_VS_CNT +: VS_W]     = vs(f_rread, q_c, q_m);
+    cfg[C_VS_LOAD +: VS_W]    = vs(q_pr, q_c, q_m);
+    cfg[C_VS_ZERO +: VS_W]    = vs({CW{1'b0}}, q_c, q_m);
+    cfg[C_VS_CEIL +: VS_W]    = vs(q_c, q_c, q_m);
+    cfg[C_VSO_LOAD +: VS_W]   = vs(f_pr, q_c, q_m);
+    cfg[C_VSO_CEIL +: VS_W]   = vs(f_c, q_c, q_m);
   end
 
   // ---- the lane -----------------------------------------------------------------------------------
