@@ -19,7 +19,7 @@ from cocotb.triggers import ClockCycles, FallingEdge
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, engine_period, lacks, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, Timebase, begin, engine_period, lacks, run_feature
 from enctools.qei.model import RANGES, QeiModel
 from enctools.qei.stimulus import BURST, WIDE, durations, near, slice_compare_cases, steps_from
 from enctools.regmap import get_field, pack, regmap
@@ -272,16 +272,7 @@ async def range_change_across_the_wrap(dut):
     ceiling = 1000
     cases = (("limit", 2, (-1, -1, -1, -1, 1, 1)), ("modulo", 2, (-1, -1, -1, -1, 1, 1)),
              ("limit", -2, (1,) * 6), ("modulo", -2, (1,) * 6))
-    ts_mask = (1 << int(dut.TS_W.value)) - 1
-    tb = dut.u_qei.timebase
-    now = [int(tb.value), int(tb.value)]  # (the timebase unwrapped, its last raw value)
-
-    def unwrapped() -> int:
-        raw = int(tb.value)
-        now[0] += (raw - now[1]) & ts_mask
-        now[1] = raw
-        return now[0]
-
+    clock = Timebase(dut)
     p = engine_period(int(dut.CHANNELS.value)) if env.engine else 1
     span = 2 * p + 24 if env.engine else 8
     r0 = rng.randrange(p)
@@ -289,11 +280,7 @@ async def range_change_across_the_wrap(dut):
         mode, start, steps = cases[i % len(cases)]
         start &= model.max
         await env.setup(model, rng_mode="free", filter_len=1, count=start, ceiling=ceiling)
-        unwrapped()
-        while True:  # (the engine's visits and the timebase both start at rst)
-            await FallingEdge(dut.clk)
-            if unwrapped() % p == r0:
-                break
+        await clock.phase(p, r0)
 
         async def play() -> None:
             for _ in range(i):
@@ -321,7 +308,6 @@ async def range_change_across_the_wrap(dut):
             f"{mode} from {start:#x}, steps {steps} {i} clocks after the CTRL write: COUNT {got[0]:#x}, " \
             f"EVENTS {sorted(got[1])}; the range changing between two steps gives one of " \
             + ", ".join(f"({c:#x}, {sorted(e)})" for c, e in outcomes)
-        unwrapped()
     await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1))
 
 

@@ -20,8 +20,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, signed
-from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, begin, engine_build, engine_period,
-                              lacks, read_snapshot, run_feature)
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, Timebase, begin, engine_build,
+                              engine_period, lacks, read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import ClockWalk, Timeline, durations
 from enctools.regmap import event_bits, pack
@@ -472,25 +472,14 @@ async def edge_time_across_count_writes(dut):
     model = QeiModel(env.count_w)
     await env.setup(model, count=rng.getrandbits(16), filter_len=3)
     await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE="any"))
-    ts_mask = (1 << int(dut.TS_W.value)) - 1
-    tb = dut.u_qei.timebase
-    now = [int(tb.value), int(tb.value)]  # (the timebase unwrapped, its last raw value)
-
-    def unwrapped() -> int:
-        raw = int(tb.value)
-        now[0] += (raw - now[1]) & ts_mask
-        now[1] = raw
-        return now[0]
-
+    clock = Timebase(dut)
+    ts_mask = clock.mask
     p = engine_period(int(dut.CHANNELS.value)) if env.engine else 1
     span = 2 * p + 24 if env.engine else 8
     r0 = rng.randrange(p)
     pipe = Timeline.EDGE_PIPE + 2
     for i in range(span):
-        while True:  # (the engine's visits and the timebase both start at rst)
-            await FallingEdge(dut.clk)
-            if unwrapped() % p == r0:
-                break
+        await clock.phase(p, r0)
         at = []
 
         async def step() -> None:
@@ -498,7 +487,7 @@ async def edge_time_across_count_writes(dut):
                 await FallingEdge(dut.clk)
             env.pos += 1
             dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
-            at.append(unwrapped())
+            at.append(clock.now())
 
         task = cocotb.start_soon(step())
         await bus.wr("COUNT_LO", rng.getrandbits(32))
@@ -511,7 +500,7 @@ async def edge_time_across_count_writes(dut):
         assert edge == (at[0] + pipe) & ts_mask, \
             f"step {i} clocks after a COUNT_LO write (pins at timebase {at[0] & ts_mask:#x}): " \
             f"SNAP_EDGE_TIME {edge:#x}, not {(at[0] + pipe) & ts_mask:#x}"
-        unwrapped()
+        clock.now()
     await bus.wr("SNAP_CTRL", 0)
 
 

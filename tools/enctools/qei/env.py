@@ -18,7 +18,7 @@ Stimulus helpers (waveforms, clock-exact steps, resets) are in enctools.qei.stim
 from __future__ import annotations
 
 import cocotb
-from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel import QUAD
 
@@ -53,6 +53,33 @@ def engine_period(channels: int) -> int:
     """P: the clocks between two reads of a channel by the shared engine (one visit per channel,
     at least two channels: one idle with one channel)."""
     return ENGINE_VISIT * max(channels, 2)
+
+
+class Timebase:
+    """The design's timebase (``u_qei.timebase``, TS_W bits) counted on without wrapping, and the
+    wait for one phase of the shared engine's visits (they and the timebase both start at rst,
+    the timebase advancing every clock)."""
+
+    def __init__(self, dut):
+        self.dut = dut
+        self.sig = dut.u_qei.timebase
+        self.mask = (1 << int(dut.TS_W.value)) - 1
+        self.raw = int(self.sig.value)
+        self.total = self.raw
+
+    def now(self) -> int:
+        """The timebase now, unwrapped (call it at least once per 2^TS_W clocks)."""
+        raw = int(self.sig.value)
+        self.total += (raw - self.raw) & self.mask
+        self.raw = raw
+        return self.total
+
+    async def phase(self, p: int, r: int) -> None:
+        """Wait for the falling clock edge at which now() mod p is r."""
+        while True:
+            await FallingEdge(self.dut.clk)
+            if self.now() % p == r:
+                return
 
 
 def engine_lag(channels: int) -> int:
