@@ -496,6 +496,72 @@ async def lanes_probe_compare_per_channel(dut):
         assert await bus.rd("CTRL") == ctrl
         await bus.wr("PRESET_LO", 0)
 
+
+@cocotb_test()
+async def presets_ranges_periods_per_channel(dut):
+    """Per channel, through its own page and pins, what the shared engine keeps per channel and
+    hands to each lane: index presets of PRESET with every low bit both ways (two PRESETs, one
+    the complement of the other, the channel number in them), and a one-shot preset (ARM clears
+    after the first index: a second pulse presets nothing), each followed by steps. On a full
+    build also a modulo range with CEILING near the count (20 + k), up across CEILING and down
+    across 0, and one step up from CEILING a window after a COUNT write (in clocks of both
+    parities), and the period capture (N = 1, any edge, states of 5 + 2k and 90 + 4k clocks:
+    PERIOD and PERIOD_READY on that channel only). COUNT and EVENTS as the model's."""
+    envs, rng = await start_channels(dut)
+    for k, env in enumerate(envs):
+        model = QeiModel(env.count_w)
+        await env.setup(model, count=rng.getrandbits(16), filter_len=1)
+        for value, oneshot in ((0xA5C3_5A3C ^ k, False), (0x5A3C_A5C3 ^ k, False), (0x1234_5678 + k, True)):
+            value &= model.max
+            await env.bus.set64("PRESET", value)
+            await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1,
+                                                ONESHOT=int(oneshot)))
+            model.preset, model.idx_action, model.idx_edge, model.idx_arm = value, "preset", "rising", True
+            model.idx_gate, model.idx_oneshot = None, oneshot
+            await env.applied()
+            # an index pulse two steps in, another five steps later (the one-shot takes the first)
+            marks = (env.pos + 2, env.pos + 7)
+            wf = walk([1] * 9 + [-1] * 3, [12 * T_NS] * 12, start_pos=env.pos)
+            await env.play(wf, model, zfun=lambda p, m=marks: int(p in m))
+            await env.check(model, f"channel {k}: index preset of {value:#x} (one-shot {oneshot}) and steps")
+            await env.bus.wr("INDEX_CTRL", 0)
+            model.idx_action = "none"
+    if envs[0].lean:  # (no range modes, no period unit)
+        return
+    for k, env in enumerate(envs):
+        model = QeiModel(env.count_w)
+        ceiling = 20 + k
+        await env.setup(model, rng_mode="modulo", count=ceiling - 3, ceiling=ceiling, filter_len=1)
+        wf = walk([1] * 6 + [-1] * 26 + [1] * 4, [3 * T_NS] * 36, start_pos=env.pos)
+        await env.play(wf, model)
+        await env.check(model, f"channel {k}: modulo CEILING {ceiling}, across both ends")
+        # one step up from CEILING, a window after the last load (the range ends then come from
+        # the count at the read before), in clocks of both parities
+        for delay in (0, 1):
+            await env.setup(model, rng_mode="modulo", count=ceiling, ceiling=ceiling, filter_len=1)
+            await ClockCycles(dut.clk, delay)
+            await env.play(walk([1], [3 * T_NS], start_pos=env.pos), model)
+            await env.check(model, f"channel {k}: modulo CEILING {ceiling}, a step up from it ({delay})")
+        await env.setup(model, filter_len=1)
+    for e in envs:
+        await e.bus.events()
+    for k, env in enumerate(envs):
+        # (states shorter and longer than the engine's P = 72 clocks at three channels: several
+        # period boundaries in one engine window, or one)
+        for d in (5 + 2 * k, 90 + 4 * k):
+            await env.bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+            await env.applied()
+            await env.play(walk([1] * 8, [d * T_NS] * 8, start_pos=env.pos), None)
+            period = await env.bus.rd("PERIOD")
+            assert period == d, f"channel {k}: PERIOD {period} over states of {d} clocks"
+            assert "PERIOD_READY" in await env.bus.events(), f"channel {k}: no PERIOD_READY"
+            await env.bus.wr("PERIOD_CTRL", 0)
+            for j, e in enumerate(envs):
+                if j != k:
+                    assert "PERIOD_READY" not in await e.bus.events(), \
+                        f"a period on channel {k} raised PERIOD_READY on channel {j}"
+
+
 # ---- pytest --------------------------------------------------------------------------------------
 @pytest.mark.parametrize("top,channels,profile,count_w,ts_w,engine", CHANNEL_CONFIGS,
                          ids=[f"{t}-ch{c}-{p}" + ("-engine" if e else "")
