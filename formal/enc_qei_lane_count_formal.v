@@ -43,6 +43,7 @@
 // Not here: whether the engine stores what it rebuilds (simulation: test_engine, test_channels),
 // and when the index and probe edges are qualified (the decode's and the probe filter's timing).
 `default_nettype none
+`include "enc_qei_lane_w.vh"
 
 module enc_qei_lane_count_formal #(
     parameter integer CHANNELS = 2  // the engine's channels: P and the widths from them
@@ -56,24 +57,12 @@ module enc_qei_lane_count_formal #(
     input wire probe_in
 );
 
-  // ---- the engine's widths (rtl/enc_qei_engine.v) ---------------------------------------------
-  function integer clog2;
-    input integer v;
-    integer       n;
-    begin
-      clog2 = 0;
-      for (n = 1; n < v; n = n * 2) begin
-        clog2 = clog2 + 1;
-      end
-    end
-  endfunction
-
-  localparam integer CH_EFF = (CHANNELS < 2) ? 2 : CHANNELS;
-  localparam integer P      = 24 * CH_EFF;
-  localparam integer REACH  = 2 * P + 4;
-  localparam integer MOT_W  = clog2(2 * REACH + 1) + 1;
-  localparam integer TIM_W  = clog2(2 * P + 64);
-  localparam integer ERR_W  = clog2(P + 2) + 1;
+  // ---- the engine's widths (rtl/enc_qei_lane_w.vh, as enc_qei_engine sizes them) ----------
+  localparam integer P      = `ENC_QEI_ENGINE_P(CHANNELS);
+  localparam integer REACH  = `ENC_QEI_ENGINE_REACH(CHANNELS);
+  localparam integer MOT_W  = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
+  localparam integer TIM_W  = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
+  localparam integer ERR_W  = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
   `include "enc_qei_regs.vh"
   `include "enc_qei_lane.vh"
 

@@ -27,6 +27,7 @@
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
 // formal/README.md: that comparison did not finish within the time a task may take).
 `default_nettype none
+`include "enc_qei_lane_w.vh"
 
 module enc_qei_lane_formal #(
     parameter integer CHANNELS = 2,   // the engine's channels: P and the widths from them
@@ -46,24 +47,11 @@ module enc_qei_lane_formal #(
     input wire snap_hold
 );
 
-  // ---- the engine's widths (rtl/enc_qei_engine.v) ---------------------------------------------
-  function integer clog2;
-    input integer v;
-    integer       n;
-    begin
-      clog2 = 0;
-      for (n = 1; n < v; n = n * 2) begin
-        clog2 = clog2 + 1;
-      end
-    end
-  endfunction
-
-  localparam integer CH_EFF = (CHANNELS < 2) ? 2 : CHANNELS;
-  localparam integer P      = 24 * CH_EFF;
-  localparam integer REACH  = 2 * P + 4;
-  localparam integer MOT_W  = clog2(2 * REACH + 1) + 1 - MOT_CUT;
-  localparam integer TIM_W  = clog2(2 * P + 64);
-  localparam integer ERR_W  = clog2(P + 2) + 1 - ERR_CUT;
+  // ---- the engine's widths (rtl/enc_qei_lane_w.vh, as enc_qei_engine sizes them) ----------
+  localparam integer P      = `ENC_QEI_ENGINE_P(CHANNELS);
+  localparam integer MOT_W  = `ENC_QEI_ENGINE_MOT_W(CHANNELS) - MOT_CUT;
+  localparam integer TIM_W  = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
+  localparam integer ERR_W  = `ENC_QEI_ENGINE_ERR_W(CHANNELS) - ERR_CUT;
   `include "enc_qei_lane.vh"
 
   localparam integer WW = 16;  // the wrapper's wide counts

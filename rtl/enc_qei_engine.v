@@ -96,19 +96,7 @@ module enc_qei_engine #(
   // ---- the schedule and the lanes' widths ------------------------------------------------------
   localparam integer CH_EFF = (CHANNELS < 2) ? 2 : CHANNELS;  // channels visited (one idle)
   localparam integer CH_W   = 4;                              // channel number bits
-  localparam integer V      = 24;                             // clocks per visit
-  localparam integer P      = V * CH_EFF;                     // clocks between two reads of a lane
-
-  function integer clog2;
-    input integer v;
-    integer       n;
-    begin
-      clog2 = 0;
-      for (n = 1; n < v; n = n * 2) begin
-        clog2 = clog2 + 1;
-      end
-    end
-  endfunction
+  localparam integer V      = `ENC_QEI_ENGINE_V;               // clocks per visit (P = V * CH_EFF)
 
   // A validity set pushed for the count at one read is in force until the push before the read
   // after next: it must describe every count within 2 P + 4 steps (one a clock at most) of that
@@ -117,11 +105,12 @@ module enc_qei_engine #(
   // (ticks) older than the read that hands it over; the unit timer is reloaded by the lane for a
   // SNAP_PERIOD below 2^TIM_W and armed by the engine (2^TIM_W ahead at most) above it, which
   // needs 2^TIM_W > 2 P + 64 to arm it in time. Error counts: at most one a clock.
-  localparam integer REACH = 2 * P + 4;
+  // (the formulas: rtl/enc_qei_lane_w.vh, which the lane proofs use too)
+  localparam integer REACH = `ENC_QEI_ENGINE_REACH(CHANNELS);
   localparam [63:0]  REACH64 = {32'd0, REACH[31:0]};
-  localparam integer MOT_W = clog2(2 * REACH + 1) + 1;
-  localparam integer TIM_W = clog2(2 * P + 64);
-  localparam integer ERR_W = clog2(P + 2) + 1;
+  localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
+  localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
+  localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
   `include "enc_qei_lane.vh"  // the lanes' configuration and record (CFG_W, REC_W, C_*, R_*)
 
   // A count no wider than the lane's low bits is all in them: the free range is then counted
