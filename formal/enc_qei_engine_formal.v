@@ -31,7 +31,12 @@
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy).
+// With ENGINE_DATA (tasks data, data_ch3) also the count's data path, for one channel f (any,
+// fixed; the bus writes no register of f, reads any): see the section at the end.
 `default_nettype none
+`ifdef ENGINE_DATA
+`include "enc_qei_lane_w.vh"
+`endif
 
 module enc_qei_engine_formal #(
     parameter integer CHANNELS = 2,   // the engine's channels
@@ -265,6 +270,211 @@ module enc_qei_engine_formal #(
       if (f_past_gsreq && !f_past_rst && !f_past_gsnap) assert (gsnap || p_gswait);
     end
   end
+
+`ifdef ENGINE_DATA
+  // ---- the data path of the count and its latches (tasks data, data_ch3) ----------------------------
+  // For one channel f (any, fixed; the bus writes no register of f and reads any), with the
+  // lanes' records free: at each visit of f the engine rebuilds, from the record of f's read and
+  // the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with the reset PRESET and
+  // CEILING; formal/enc_qei_lane_count.sby proves that this gives the true count, and the count
+  // at a latch's edge), the count, and the index latch, snapshot count and probe latch the record
+  // holds (pending: LPEND, SPEND, PPEND). In f's write-back (the visit after, c(v - 1) = f) it
+  // writes the count in slot 0 (only then), SNAP_COUNT in slot 12, INDEX_LATCH in slot 15 and
+  // PROBE_LATCH in slot 16, each when its capture is pending (or f's first write-back: reset
+  // values for those without one), and otherwise leaves the word; the state memory keeps them
+  // (and PRESET and CEILING at their reset values); a bus read of COUNT_LO, SNAP_COUNT_LO,
+  // INDEX_LATCH_LO or PROBE_LATCH_LO answers the word as stored in the clock of its port-b read
+  // (0, the reset value, until f's first write-back is complete).
+  localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
+  localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
+  localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
+  `include "enc_qei_regs.vh"
+  `include "enc_qei_lane.vh"
+  localparam [63:0] SZ       = (64'd1 << COUNT_W) - 64'd1;
+  localparam [63:0] PRE_RST  = {ENC_QEI_PRESET_HI_RESET, ENC_QEI_PRESET_LO_RESET} & SZ;
+  localparam [63:0] CEIL_RST = {ENC_QEI_CEILING_HI_RESET, ENC_QEI_CEILING_LO_RESET} & SZ;
+  localparam [4:0]  W_CNT = 5'd0, W_PRESET = 5'd4, W_CEIL = 5'd5, W_SCNT = 5'd13, W_ILATCH = 5'd16,
+                    W_PLATCH = 5'd17;
+  localparam [4:0]  S_SCNT = 5'd12, S_ILATCH = 5'd15, S_PLATCH = 5'd16;  // their write slots
+  localparam integer NPEEK = 6;  // enc_qei_ram's F_PEEK
+
+  (* anyconst *) reg [3:0] f_ch;
+  wire [AW-1:0] a_cnt = {f_ch, W_CNT}, a_pre = {f_ch, W_PRESET}, a_ceil = {f_ch, W_CEIL};
+  wire [AW-1:0] a_scnt = {f_ch, W_SCNT}, a_ilat = {f_ch, W_ILATCH}, a_plat = {f_ch, W_PLATCH};
+
+  (* keep *) wire [REC_W-1:0]    p_rec_or;   // eng.rec_or: the record of the lane read now
+  (* keep *) wire [REC_W-1:0]    p_rec_q;    // eng.rec_q: c(v)'s
+  (* keep *) wire [63:0]         p_o_cnt;    // eng.o_cnt
+  (* keep *) wire [63:0]         p_o_pre;    // eng.o_pre
+  (* keep *) wire [63:0]         p_o_ceil;   // eng.o_ceil
+  (* keep *) wire [63:0]         p_n_cnt;    // eng.n_cnt_q
+  (* keep *) wire [63:0]         p_n_scnt;   // eng.n_scnt_q
+  (* keep *) wire [63:0]         p_n_ilat;   // eng.n_ilatch_q
+  (* keep *) wire [63:0]         p_n_plat;   // eng.n_platch_q
+  (* keep *) wire                p_n_snap;   // eng.n_snap_q: SNAP_* are written
+  (* keep *) wire                p_n_latch;  // eng.n_latch_q: INDEX_LATCH is
+  (* keep *) wire                p_n_probe;  // eng.n_probe_q: PROBE_LATCH is
+  (* keep *) wire [63:0]         p_wdata;    // eng.wdata
+  (* keep *) wire [63:0]         p_wmask;    // eng.wmask
+  (* keep *) wire [CHANNELS-1:0] p_fresh;    // eng.fresh_q
+  (* keep *) wire                p_b_wr;     // eng.b_wr_q
+  (* keep *) wire [5:0]          p_b_word;   // eng.b_word_q
+  (* keep *) wire [31:0]         p_b_rdata;  // eng.b_rdata_q
+  (* keep *) wire                p_ip_fresh; // eng.ip_fresh_q: c(v - 1) was fresh at its visit
+  (* keep *) wire [1:0]          p_ip_pre;   // eng.ip_pre_q: its write's PRESET halves
+  (* keep *) wire [1:0]          p_ip_ceil;  // eng.ip_ceil_q: ... CEILING halves
+  (* keep *) wire [NPEEK*64-1:0] p_peek;     // eng.u_mem.f_peek: the words of f_peek_addr
+  (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
+  wire [63:0] m_cnt  = p_peek[0 +: 64],   m_pre  = p_peek[64 +: 64],  m_ceil = p_peek[128 +: 64];
+  wire [63:0] m_scnt = p_peek[192 +: 64], m_ilat = p_peek[256 +: 64], m_plat = p_peek[320 +: 64];
+
+  // the reference: the record of f's last read (rst: channel 0's first visit takes the reset
+  // record, 0); the count stored (f_sto) and the one stored before it (f_base: the count at the
+  // read the record continues from); the latched words stored
+  reg  [MOT_W-1:0] f_lo, f_scap, f_icap, f_pcap;
+  reg  [1:0]       f_anc, f_sanc, f_ianc, f_panc;
+  reg              f_spend, f_ipend, f_ppend;
+  reg  [63:0]      f_sto, f_base, f_scnt, f_ilat, f_plat;
+  reg  [63:0]      f_sto_d, f_scnt_d, f_ilat_d, f_plat_d;
+  reg  [31:0]      f_exp;  // what the bus read of f under way answers
+  reg              f_chk;  // ... one is under way, past its take
+  wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, PRE_RST, CEIL_RST, f_base, SZ);
+  wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
+  wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
+  wire [63:0]      f_pnew  = f_ppend ? lane_rebuild(f_pcap, f_panc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
+  wire             f_fresh = |(p_fresh & (1 << f_ch));
+  wire             f_wbv   = p_wr_on && p_cw == f_ch;                    // f's write-back visit
+  wire             f_wb    = f_wbv && p_slot == 5'd0;                    // ... its count's slot
+  wire             f_rd_now = p_slot == V - 1 && p_cn == f_ch;           // f's lane is read
+  wire             f_calc  = p_slot == V - 1 && p_cp == f_ch;            // f's visit computes
+  wire             f_bus   = p_b_take && !p_b_wr && p_b_ch == f_ch;
+  wire [5:0]       OFF_CNT = ENC_QEI_COUNT_LO[7:2], OFF_SCNT = ENC_QEI_SNAP_COUNT_LO[7:2],
+                   OFF_ILAT = ENC_QEI_INDEX_LATCH_LO[7:2], OFF_PLAT = ENC_QEI_PROBE_LATCH_LO[7:2];
+  wire             f_watched = p_b_word == OFF_CNT || p_b_word == OFF_SCNT || p_b_word == OFF_ILAT ||
+                               p_b_word == OFF_PLAT;
+  wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
+                              (p_b_word == OFF_ILAT) ? f_ilat_d : f_plat_d;
+
+  always @(*) begin
+    assume (f_ch < CHANNELS);
+    if (req_valid && req_write) assume (req_ch != f_ch);
+  end
+
+  always @(posedge clk) begin
+    f_sto_d  <= f_sto;
+    f_scnt_d <= f_scnt;
+    f_ilat_d <= f_ilat;
+    f_plat_d <= f_plat;
+    if (rst) begin
+      {f_lo, f_anc, f_spend, f_scap, f_sanc, f_ipend, f_icap, f_ianc, f_ppend, f_pcap, f_panc} <= 0;
+      f_sto  <= 64'd0;
+      f_base <= 64'd0;
+      f_scnt <= 64'd0;
+      f_ilat <= 64'd0;
+      f_plat <= 64'd0;
+      f_chk  <= 1'b0;
+    end else begin
+      if (f_rd_now) begin
+        f_lo    <= p_rec_or[R_LO +: R_LO_W];
+        f_anc   <= p_rec_or[R_ANC +: R_ANC_W];
+        f_spend <= p_rec_or[R_SPEND];
+        f_scap  <= p_rec_or[R_SLO +: R_SLO_W];
+        f_sanc  <= p_rec_or[R_SANC +: R_SANC_W];
+        f_ipend <= p_rec_or[R_LPEND];
+        f_icap  <= p_rec_or[R_LCAP +: R_LCAP_W];
+        f_ianc  <= p_rec_or[R_LANC +: R_LANC_W];
+        f_ppend <= p_rec_or[R_PPEND];
+        f_pcap  <= p_rec_or[R_PLO +: R_PLO_W];
+        f_panc  <= p_rec_or[R_PANC +: R_PANC_W];
+      end
+      if (f_calc) f_base <= f_sto;
+      if (f_wb) f_sto <= f_new;
+      if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
+      if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
+      if (f_wbv && p_slot == S_PLATCH && (f_ppend || f_fresh)) f_plat <= f_pnew;
+      if (f_bus && f_watched) begin
+        f_exp <= f_fresh ? 32'd0 : f_word_d[31:0];
+        f_chk <= 1'b1;
+      end else if (resp_valid) begin
+        f_chk <= 1'b0;
+      end
+    end
+  end
+
+  // a latched word: written only in its slot of f's write-back, whole, with its new value, when
+  // its capture is pending or f is fresh; stored from then on (or while f is not fresh)
+  task latch_word;
+    input [AW-1:0] a;
+    input [4:0]    slot;
+    input          pend;
+    input [63:0]   nv;     // its new value
+    input [63:0]   m;      // the memory's word
+    input [63:0]   f;      // the reference's
+    input [63:0]   n_q;    // the engine's new value
+    input          n_on;   // ... and its write enable
+    begin
+      if (f_wbv && p_slot <= slot) assert (n_on == (pend || f_fresh) && n_q == nv);
+      if (p_we && p_waddr == a) begin
+        assert (f_wbv && p_slot == slot);
+        assert (p_wmask == {64{pend || f_fresh}} && p_wdata == nv);
+      end
+      if (!f_fresh || (f_wbv && p_slot > slot)) assert (m == f);
+      else assert (f == 64'd0);
+    end
+  endtask
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      // no write to f from the bus: its slot stays free (and a request of f is a read)
+      assert (!(|((p_pend | p_busy) & (1 << f_ch))));
+      if (p_b_st != B_IDLE && p_b_ch == f_ch) assert (!p_b_wr);
+      // the count word of f is written only by f's write-back, with the rebuilt count
+      if (f_wb) assert (p_we && p_waddr == a_cnt && p_wmask == {64{1'b1}} && p_wdata == f_new &&
+                        p_n_cnt == f_new);
+      else if (p_we) assert (p_waddr != a_cnt);
+      // PRESET and CEILING of f: written only with their reset values
+      if (p_we && p_waddr == a_pre) assert (((p_wdata ^ PRE_RST) & p_wmask & SZ) == 64'd0);
+      if (p_we && p_waddr == a_ceil) assert (((p_wdata ^ CEIL_RST) & p_wmask & SZ) == 64'd0);
+      // the memory: from f's write-back of each word on (its first one), or f no longer fresh
+      if (!f_fresh || (f_wbv && p_slot >= 5'd1)) assert (m_cnt == f_sto);
+      if (!f_fresh || (f_wbv && p_slot >= 5'd5)) assert ((m_pre & SZ) == PRE_RST);
+      if (!f_fresh || (f_wbv && p_slot >= 5'd6)) assert ((m_ceil & SZ) == CEIL_RST);
+      if (f_fresh && !(f_wbv && p_slot >= 5'd1)) assert (f_sto == 64'd0);
+      assert ((f_sto & ~SZ) == 64'd0);
+      latch_word(a_scnt, S_SCNT, f_spend, f_snew, m_scnt, f_scnt, p_n_scnt, p_n_snap);
+      latch_word(a_ilat, S_ILATCH, f_ipend, f_inew, m_ilat, f_ilat, p_n_ilat, p_n_latch);
+      latch_word(a_plat, S_PLATCH, f_ppend, f_pnew, m_plat, f_plat, p_n_plat, p_n_probe);
+      // (f is fresh until the end of slot 19 of its first write-back; the first visit writes nothing)
+      if (f_wbv && p_slot >= 5'd20) assert (!f_fresh);
+      if (!p_wr_on) assert (p_cp == 4'd0 && f_fresh && f_sto == 64'd0);
+      // f's write-back writes PRESET and CEILING whole while f is fresh, else not at all; the
+      // count at the read before is the one its visit rebuilt from
+      if (f_wbv) begin
+        if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
+        assert (p_ip_pre == 2'd0 && p_ip_ceil == 2'd0);
+        if (p_slot == 5'd0) assert (f_base == f_sto);
+      end
+      // f's visit: the record of its read, the loads of the stored words
+      if (p_cp == f_ch) begin
+        assert (p_rec_q[R_LO +: R_LO_W] == f_lo && p_rec_q[R_ANC +: R_ANC_W] == f_anc);
+        assert (p_rec_q[R_SPEND] == f_spend && p_rec_q[R_SLO +: R_SLO_W] == f_scap &&
+                p_rec_q[R_SANC +: R_SANC_W] == f_sanc);
+        assert (p_rec_q[R_LPEND] == f_ipend && p_rec_q[R_LCAP +: R_LCAP_W] == f_icap &&
+                p_rec_q[R_LANC +: R_LANC_W] == f_ianc);
+        assert (p_rec_q[R_PPEND] == f_ppend && p_rec_q[R_PLO +: R_PLO_W] == f_pcap &&
+                p_rec_q[R_PANC +: R_PANC_W] == f_panc);
+        if (p_slot >= 5'd12) assert (p_o_cnt == f_sto);
+        if (p_slot >= 5'd19) assert (p_o_pre == PRE_RST);
+        if (p_slot >= 5'd20) assert (p_o_ceil == CEIL_RST);
+      end
+      // the bus: a read of f's COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO or PROBE_LATCH_LO answers
+      // the word as stored in the clock of its port-b read
+      if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
+                         p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
+      if (f_chk && resp_valid) assert (resp_rdata == f_exp);
+    end
+  end
+`endif
 
 endmodule
 

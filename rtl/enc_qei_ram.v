@@ -45,6 +45,21 @@ module enc_qei_ram #(
   assign rdata_a = rdata_a_q;
   assign rdata_b = rdata_b_q;
 
+`ifdef FORMAL
+  // A proof's view of F_PEEK words (formal/enc_qei_engine.sby, tasks data and data_ch3, read
+  // this file with FORMAL defined and drive f_peek_addr after flatten): word i of f_peek is
+  // mem[f_peek_addr[i]] now, no clock.
+  localparam integer F_PEEK = 6;
+  wire [F_PEEK*AW-1:0] f_peek_addr;
+  (* keep *) wire [F_PEEK*W-1:0] f_peek;
+  genvar f_i;
+  generate
+    for (f_i = 0; f_i < F_PEEK; f_i = f_i + 1) begin : g_f_peek
+      assign f_peek[f_i*W +: W] = mem[f_peek_addr[f_i*AW +: AW]];
+    end
+  endgenerate
+`endif
+
 endmodule
 
 `default_nettype wire
