@@ -31,8 +31,9 @@
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy).
-// With ENGINE_DATA (tasks data, data_ch3) also the count's data path, for one channel f (any,
-// fixed; the bus writes no register of f, reads any): see the section at the end.
+// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count and its latches, for
+// one channel f (any, fixed; the bus writes none of its COUNT, PRESET, CEILING): see the section
+// at the end.
 `default_nettype none
 `ifdef ENGINE_DATA
 `include "enc_qei_lane_w.vh"
@@ -273,8 +274,8 @@ module enc_qei_engine_formal #(
 
 `ifdef ENGINE_DATA
   // ---- the data path of the count and its latches (tasks data, data_ch3) ----------------------------
-  // For one channel f (any, fixed; the bus writes no register of f and reads any), with the
-  // lanes' records free: at each visit of f the engine rebuilds, from the record of f's read and
+  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_LO /
+  // _HI, PRESET_LO / _HI and CEILING_LO / _HI), with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's read and
   // the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with the reset PRESET and
   // CEILING; formal/enc_qei_lane_count.sby proves that this gives the true count, and the count
   // at a latch's edge), the count, and the index latch, snapshot count and probe latch the record
@@ -324,7 +325,12 @@ module enc_qei_engine_formal #(
   (* keep *) wire [1:0]          p_ip_pre;   // eng.ip_pre_q: its write's PRESET halves
   (* keep *) wire [1:0]          p_ip_ceil;  // eng.ip_ceil_q: ... CEILING halves
   (* keep *) wire [NPEEK*64-1:0] p_peek;     // eng.u_mem.f_peek: the words of f_peek_addr
+  (* keep *) wire [NPEEK*42-1:0] p_slot_pk;  // eng.u_pend.f_peek: word 0 is f's write slot
+  (* keep *) wire [41:0]         p_n_pend;   // eng.n_pend: c(v + 1)'s write, as taken
+  (* keep *) wire [41:0]         p_p_pend;   // eng.p_pend: c(v)'s, taken at its push
+  (* keep *) wire [41:0]         p_e_pend;   // eng.e_pend: c(v)'s state write
   (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
+  (* keep *) wire [NPEEK*4-1:0]  f_slot_addr = {NPEEK{f_ch}};  // -> eng.u_pend.f_peek_addr
   wire [63:0] m_cnt  = p_peek[0 +: 64],   m_pre  = p_peek[64 +: 64],  m_ceil = p_peek[128 +: 64];
   wire [63:0] m_scnt = p_peek[192 +: 64], m_ilat = p_peek[256 +: 64], m_plat = p_peek[320 +: 64];
 
@@ -355,9 +361,19 @@ module enc_qei_engine_formal #(
   wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
                               (p_b_word == OFF_ILAT) ? f_ilat_d : f_plat_d;
 
+  // the registers whose writes reach the count: not written on f
+  function count_reg;
+    input [5:0] off;
+    begin
+      count_reg = off == ENC_QEI_COUNT_LO[7:2] || off == ENC_QEI_COUNT_HI[7:2] ||
+                  off == ENC_QEI_PRESET_LO[7:2] || off == ENC_QEI_PRESET_HI[7:2] ||
+                  off == ENC_QEI_CEILING_LO[7:2] || off == ENC_QEI_CEILING_HI[7:2];
+    end
+  endfunction
+
   always @(*) begin
     assume (f_ch < CHANNELS);
-    if (req_valid && req_write) assume (req_ch != f_ch);
+    if (req_valid && req_write && req_ch == f_ch) assume (!count_reg(req_word));
   end
 
   always @(posedge clk) begin
@@ -425,9 +441,14 @@ module enc_qei_engine_formal #(
 
   always @(*) begin
     if (f_past && !rst) begin
-      // no write to f from the bus: its slot stays free (and a request of f is a read)
-      assert (!(|((p_pend | p_busy) & (1 << f_ch))));
-      if (p_b_st != B_IDLE && p_b_ch == f_ch) assert (!p_b_wr);
+      // a write of f (of a register that does not reach the count) on its way: the bus's
+      // request, f's write slot while the write waits or is applied, the write as taken for the
+      // push (slot 10 on), at the visit, and as a state write (slot 22 on)
+      if (p_b_st != B_IDLE && p_b_ch == f_ch && p_b_wr) assert (!count_reg(p_b_word));
+      if (|((p_pend | p_busy) & (1 << f_ch))) assert (!count_reg(p_slot_pk[41:36]));
+      if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (!count_reg(p_n_pend[41:36]));
+      if (p_cp == f_ch && p_p_taken) assert (!count_reg(p_p_pend[41:36]));
+      if (p_cp == f_ch && p_slot == V - 1 && p_e_taken) assert (!count_reg(p_e_pend[41:36]));
       // the count word of f is written only by f's write-back, with the rebuilt count
       if (f_wb) assert (p_we && p_waddr == a_cnt && p_wmask == {64{1'b1}} && p_wdata == f_new &&
                         p_n_cnt == f_new);
