@@ -32,8 +32,8 @@
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy).
 // With ENGINE_DATA (tasks data, data_ch3) also the data path of the count and its latches, for
-// one channel f (any, fixed; the bus writes none of its COUNT, PRESET, CEILING): see the section
-// at the end.
+// one channel f (any, fixed; the bus writes any of its registers but COUNT_HI, PRESET, CEILING):
+// see the section at the end.
 `default_nettype none
 `ifdef ENGINE_DATA
 `include "enc_qei_lane_w.vh"
@@ -274,18 +274,21 @@ module enc_qei_engine_formal #(
 
 `ifdef ENGINE_DATA
   // ---- the data path of the count and its latches (tasks data, data_ch3) ----------------------------
-  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_LO /
-  // _HI, PRESET_LO / _HI and CEILING_LO / _HI), with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's read and
-  // the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with the reset PRESET and
-  // CEILING; formal/enc_qei_lane_count.sby proves that this gives the true count, and the count
-  // at a latch's edge), the count, and the index latch, snapshot count and probe latch the record
-  // holds (pending: LPEND, SPEND, PPEND). In f's write-back (the visit after, c(v - 1) = f) it
-  // writes the count in slot 0 (only then), SNAP_COUNT in slot 12, INDEX_LATCH in slot 15 and
-  // PROBE_LATCH in slot 16, each when its capture is pending (or f's first write-back: reset
-  // values for those without one), and otherwise leaves the word; the state memory keeps them
-  // (and PRESET and CEILING at their reset values); a bus read of COUNT_LO, SNAP_COUNT_LO,
-  // INDEX_LATCH_LO or PROBE_LATCH_LO answers the word as stored in the clock of its port-b read
-  // (0, the reset value, until f's first write-back is complete).
+  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI,
+  // PRESET_LO / _HI and CEILING_LO / _HI), with the lanes' records free: at each visit of f the
+  // engine rebuilds, from the record of f's read and the count it stored before (lane_rebuild of
+  // rtl/enc_qei_lane.vh, with the reset PRESET and CEILING, and for the anchor A_LOAD the value
+  // of a COUNT_LO write taken at the push before the read; formal/enc_qei_lane_count.sby proves
+  // that this gives the true count, and the count at a latch's edge), the count, and the index
+  // latch, snapshot count and probe latch the record holds (pending: LPEND, SPEND, PPEND). In f's
+  // write-back (the visit after, c(v - 1) = f) it writes the count in slot 0 (only then),
+  // SNAP_COUNT in slot 12, INDEX_LATCH in slot 15 and PROBE_LATCH in slot 16, each when its
+  // capture is pending (or f's first write-back: reset values for those without one), and
+  // otherwise leaves the word; the state memory keeps them (and PRESET and CEILING at their
+  // reset values); a bus read of COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO or PROBE_LATCH_LO answers
+  // the word as stored in the clock of its port-b read (0, the reset value, until f's first
+  // write-back is complete). A COUNT_LO write carries its bytes and, in those it leaves, COUNT_LO
+  // as read when it was written; no other write of f reaches these words.
   localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
   localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
   localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
@@ -329,6 +332,10 @@ module enc_qei_engine_formal #(
   (* keep *) wire [41:0]         p_n_pend;   // eng.n_pend: c(v + 1)'s write, as taken
   (* keep *) wire [41:0]         p_p_pend;   // eng.p_pend: c(v)'s, taken at its push
   (* keep *) wire [41:0]         p_e_pend;   // eng.e_pend: c(v)'s state write
+  (* keep *) wire [41:0]         p_pend_wd;  // eng.pend_wdata: the write into a write slot
+  (* keep *) wire [31:0]         p_b_wdata;  // eng.b_wdata_q: the bus request's data
+  (* keep *) wire [3:0]          p_b_wstrb;  // eng.b_wstrb_q: ... its byte enables
+  (* keep *) wire [31:0]         p_b_cnt;    // eng.b_cnt_q: COUNT_LO as read for a write
   (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
   (* keep *) wire [NPEEK*4-1:0]  f_slot_addr = {NPEEK{f_ch}};  // -> eng.u_pend.f_peek_addr
   wire [63:0] m_cnt  = p_peek[0 +: 64],   m_pre  = p_peek[64 +: 64],  m_ceil = p_peek[128 +: 64];
@@ -344,7 +351,13 @@ module enc_qei_engine_formal #(
   reg  [63:0]      f_sto_d, f_scnt_d, f_ilat_d, f_plat_d;
   reg  [31:0]      f_exp;  // what the bus read of f under way answers
   reg              f_chk;  // ... one is under way, past its take
-  wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, PRE_RST, CEIL_RST, f_base, SZ);
+  reg              f_pw_ok;  // the write in f's slot (or on its way there) is a COUNT_LO write
+  reg  [31:0]      f_pw;     // ... of this value (its bytes, the rest from COUNT as then read)
+  reg  [31:0]      f_bcnt;   // COUNT_LO as read for a COUNT_LO write of f with some lanes off
+  reg              f_ld_ok;  // the read of the record loaded a COUNT_LO write (taken at its push)
+  reg  [31:0]      f_ld;     // ... of this value
+  wire [63:0]      f_ldb   = f_ld_ok ? {32'd0, f_ld} & SZ : PRE_RST;  // the anchor A_LOAD's value
+  wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, f_ldb, CEIL_RST, f_base, SZ);
   wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
   wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
   wire [63:0]      f_pnew  = f_ppend ? lane_rebuild(f_pcap, f_panc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
@@ -361,13 +374,32 @@ module enc_qei_engine_formal #(
   wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
                               (p_b_word == OFF_ILAT) ? f_ilat_d : f_plat_d;
 
-  // the registers whose writes reach the count: not written on f
+  // the registers besides COUNT_LO whose writes reach the count: not written on f
   function count_reg;
     input [5:0] off;
     begin
-      count_reg = off == ENC_QEI_COUNT_LO[7:2] || off == ENC_QEI_COUNT_HI[7:2] ||
+      count_reg = off == ENC_QEI_COUNT_HI[7:2] ||
                   off == ENC_QEI_PRESET_LO[7:2] || off == ENC_QEI_PRESET_HI[7:2] ||
                   off == ENC_QEI_CEILING_LO[7:2] || off == ENC_QEI_CEILING_HI[7:2];
+    end
+  endfunction
+
+  function [31:0] lanes_of;  // byte enables -> bit mask
+    input [3:0] st;
+    begin
+      lanes_of = {{8{st[3]}}, {8{st[2]}}, {8{st[1]}}, {8{st[0]}}};
+    end
+  endfunction
+
+  // a write, {offset, byte enables, data}, as a write slot holds it: a COUNT_LO write (with some
+  // byte enable) of f's value f_pw when ok, else a write of no register that reaches the count
+  function slot_ok;
+    input [41:0] w;
+    input        ok;
+    input [31:0] v;
+    begin
+      slot_ok = !count_reg(w[41:36]) &&
+                ((w[41:36] == OFF_CNT && |w[35:32]) ? (ok && w[35:32] == 4'hF && w[31:0] == v) : !ok);
     end
   endfunction
 
@@ -389,8 +421,12 @@ module enc_qei_engine_formal #(
       f_ilat <= 64'd0;
       f_plat <= 64'd0;
       f_chk  <= 1'b0;
+      f_ld_ok <= 1'b0;
+      f_pw_ok <= 1'b0;
     end else begin
       if (f_rd_now) begin
+        f_ld_ok <= p_n_taken && f_pw_ok;
+        f_ld    <= f_pw;
         f_lo    <= p_rec_or[R_LO +: R_LO_W];
         f_anc   <= p_rec_or[R_ANC +: R_ANC_W];
         f_spend <= p_rec_or[R_SPEND];
@@ -408,6 +444,11 @@ module enc_qei_engine_formal #(
       if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
       if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
       if (f_wbv && p_slot == S_PLATCH && (f_ppend || f_fresh)) f_plat <= f_pnew;
+      if (p_b_take && p_b_wr && p_b_ch == f_ch) f_bcnt <= f_fresh ? 32'd0 : f_sto_d[31:0];
+      if (p_b_st == B_POST && p_b_ch == f_ch) begin
+        f_pw_ok <= p_b_word == OFF_CNT && |p_b_wstrb;
+        f_pw    <= (f_bcnt & ~lanes_of(p_b_wstrb)) | (p_b_wdata & lanes_of(p_b_wstrb));
+      end
       if (f_bus && f_watched) begin
         f_exp <= f_fresh ? 32'd0 : f_word_d[31:0];
         f_chk <= 1'b1;
@@ -444,11 +485,21 @@ module enc_qei_engine_formal #(
       // a write of f (of a register that does not reach the count) on its way: the bus's
       // request, f's write slot while the write waits or is applied, the write as taken for the
       // push (slot 10 on), at the visit, and as a state write (slot 22 on)
+      // A COUNT_LO write of f carries its bytes and, in the others, COUNT as read at the write
+      // (when some are off) to f's read after its push, whose rebuild takes it as the value of
+      // the anchor A_LOAD.
       if (p_b_st != B_IDLE && p_b_ch == f_ch && p_b_wr) assert (!count_reg(p_b_word));
-      if (|((p_pend | p_busy) & (1 << f_ch))) assert (!count_reg(p_slot_pk[41:36]));
-      if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (!count_reg(p_n_pend[41:36]));
-      if (p_cp == f_ch && p_p_taken) assert (!count_reg(p_p_pend[41:36]));
-      if (p_cp == f_ch && p_slot == V - 1 && p_e_taken) assert (!count_reg(p_e_pend[41:36]));
+      if (p_b_st == B_POST && p_b_ch == f_ch && p_b_wr && p_b_word == OFF_CNT && |p_b_wstrb &&
+          !(&p_b_wstrb)) assert (p_b_cnt == f_bcnt);
+      if (p_pend_we && p_pend_wch == f_ch) assert (slot_ok(p_pend_wd, f_pw_ok, f_pw));
+      if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pw_ok, f_pw));
+      if (|(p_pend & p_pend_st & (1 << f_ch))) assert (!f_pw_ok);  // (a state write: not COUNT_LO)
+      if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pw_ok, f_pw));
+      if (p_cp == f_ch) begin
+        assert (p_p_taken ? slot_ok(p_p_pend, f_ld_ok, f_ld) : !f_ld_ok);
+        if (p_slot >= V - 2 && p_e_taken) assert (!f_pw_ok);
+        if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, 1'b0, 32'd0));
+      end
       // the count word of f is written only by f's write-back, with the rebuilt count
       if (f_wb) assert (p_we && p_waddr == a_cnt && p_wmask == {64{1'b1}} && p_wdata == f_new &&
                         p_n_cnt == f_new);
