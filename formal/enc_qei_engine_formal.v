@@ -458,9 +458,10 @@ module enc_qei_engine_formal #(
     end
   end
 
-  // a latched word: written only in its slot of f's write-back, whole, with its new value, when
-  // its capture is pending or f is fresh; stored from then on (or while f is not fresh)
-  task latch_word;
+  // a stored word (the count, a latched value): written only in its slot of f's write-back, whole,
+  // with its new value, when it is pending or f is fresh; stored from then on (or while f is not
+  // fresh), 0 before
+  task stored_word;
     input [AW-1:0] a;
     input [4:0]    slot;
     input          pend;
@@ -500,22 +501,18 @@ module enc_qei_engine_formal #(
         if (p_slot >= V - 2 && p_e_taken) assert (!f_pw_ok);
         if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, 1'b0, 32'd0));
       end
-      // the count word of f is written only by f's write-back, with the rebuilt count
-      if (f_wb) assert (p_we && p_waddr == a_cnt && p_wmask == {64{1'b1}} && p_wdata == f_new &&
-                        p_n_cnt == f_new);
-      else if (p_we) assert (p_waddr != a_cnt);
+      // the count word of f: written whole in slot 0 of each of f's write-backs (always pending)
+      stored_word(a_cnt, 5'd0, 1'b1, f_new, m_cnt, f_sto, p_n_cnt, 1'b1);
       // PRESET and CEILING of f: written only with their reset values
       if (p_we && p_waddr == a_pre) assert (((p_wdata ^ PRE_RST) & p_wmask & SZ) == 64'd0);
       if (p_we && p_waddr == a_ceil) assert (((p_wdata ^ CEIL_RST) & p_wmask & SZ) == 64'd0);
       // the memory: from f's write-back of each word on (its first one), or f no longer fresh
-      if (!f_fresh || (f_wbv && p_slot >= 5'd1)) assert (m_cnt == f_sto);
       if (!f_fresh || (f_wbv && p_slot >= 5'd5)) assert ((m_pre & SZ) == PRE_RST);
       if (!f_fresh || (f_wbv && p_slot >= 5'd6)) assert ((m_ceil & SZ) == CEIL_RST);
-      if (f_fresh && !(f_wbv && p_slot >= 5'd1)) assert (f_sto == 64'd0);
       assert ((f_sto & ~SZ) == 64'd0);
-      latch_word(a_scnt, S_SCNT, f_spend, f_snew, m_scnt, f_scnt, p_n_scnt, p_n_snap);
-      latch_word(a_ilat, S_ILATCH, f_ipend, f_inew, m_ilat, f_ilat, p_n_ilat, p_n_latch);
-      latch_word(a_plat, S_PLATCH, f_ppend, f_pnew, m_plat, f_plat, p_n_plat, p_n_probe);
+      stored_word(a_scnt, S_SCNT, f_spend, f_snew, m_scnt, f_scnt, p_n_scnt, p_n_snap);
+      stored_word(a_ilat, S_ILATCH, f_ipend, f_inew, m_ilat, f_ilat, p_n_ilat, p_n_latch);
+      stored_word(a_plat, S_PLATCH, f_ppend, f_pnew, m_plat, f_plat, p_n_plat, p_n_probe);
       // (f is fresh until the end of slot 19 of its first write-back; the first visit writes nothing)
       if (f_wbv && p_slot >= 5'd20) assert (!f_fresh);
       if (!p_wr_on) assert (p_cp == 4'd0 && f_fresh && f_sto == 64'd0);
