@@ -31,8 +31,8 @@
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy).
-// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count and its latches, for
-// one channel f (any, fixed; the bus writes any of its registers but COUNT_HI, PRESET, CEILING):
+// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET
+// and CEILING, for one channel f (any, fixed; the bus writes any of its registers but COUNT_HI):
 // see the section at the end.
 `default_nettype none
 `ifdef ENGINE_DATA
@@ -273,22 +273,25 @@ module enc_qei_engine_formal #(
   end
 
 `ifdef ENGINE_DATA
-  // ---- the data path of the count and its latches (tasks data, data_ch3) ----------------------------
-  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI,
-  // PRESET_LO / _HI and CEILING_LO / _HI), with the lanes' records free: at each visit of f the
-  // engine rebuilds, from the record of f's read and the count it stored before (lane_rebuild of
-  // rtl/enc_qei_lane.vh, with the reset PRESET and CEILING, and for the anchor A_LOAD the value
-  // of a COUNT_LO write taken at the push before the read; formal/enc_qei_lane_count.sby proves
-  // that this gives the true count, and the count at a latch's edge), the count, and the index
-  // latch, snapshot count and probe latch the record holds (pending: LPEND, SPEND, PPEND). In f's
-  // write-back (the visit after, c(v - 1) = f) it writes the count in slot 0 (only then),
-  // SNAP_COUNT in slot 12, INDEX_LATCH in slot 15 and PROBE_LATCH in slot 16, each when its
-  // capture is pending (or f's first write-back: reset values for those without one), and
-  // otherwise leaves the word; the state memory keeps them (and PRESET and CEILING at their
-  // reset values); a bus read of COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO or PROBE_LATCH_LO answers
-  // the word as stored in the clock of its port-b read (0, the reset value, until f's first
-  // write-back is complete). A COUNT_LO write carries its bytes and, in those it leaves, COUNT_LO
-  // as read when it was written; no other write of f reaches these words.
+  // ---- the data path of the count, its latches, PRESET and CEILING (tasks data, data_ch3) -----------
+  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI),
+  // with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's
+  // read and the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with PRESET and
+  // CEILING as stored at the visit, and for the anchor A_LOAD the value of a COUNT_LO write taken
+  // at the push before the read; formal/enc_qei_lane_count.sby proves that this gives the true
+  // count, and the count at a latch's edge), the count, and the index latch, snapshot count and
+  // probe latch the record holds (pending: LPEND, SPEND, PPEND). In f's write-back (the visit
+  // after, c(v - 1) = f) it writes the count in slot 0 (only then), PRESET in slot 4 and CEILING
+  // in slot 5 (only then: the write the visit took, its bytes in its half, the rest as stored, a
+  // fresh channel's word the reset value with the write's bytes), SNAP_COUNT in slot 12,
+  // INDEX_LATCH in slot 15 and PROBE_LATCH in slot 16, each when its capture is pending (or f's
+  // first write-back: reset values for those without one), and otherwise leaves the word; the
+  // state memory keeps them; a bus read of COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO,
+  // PROBE_LATCH_LO, PRESET_LO or CEILING_LO answers the word as stored in the clock of its port-b
+  // read (the reset value until f's first write-back is complete). A COUNT_LO write carries its
+  // bytes and, in those it leaves, COUNT_LO as read when it was written; a PRESET or CEILING write
+  // (either half) carries its data and byte enables as written; no other write of f reaches
+  // these words.
   localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
   localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
   localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
@@ -301,6 +304,10 @@ module enc_qei_engine_formal #(
                     W_PLATCH = 5'd17;
   localparam [4:0]  S_SCNT = 5'd12, S_ILATCH = 5'd15, S_PLATCH = 5'd16;  // their write slots
   localparam integer NPEEK = 6;  // enc_qei_ram's F_PEEK
+  localparam [5:0]  OFF_CNT = ENC_QEI_COUNT_LO[7:2], OFF_SCNT = ENC_QEI_SNAP_COUNT_LO[7:2],
+                    OFF_ILAT = ENC_QEI_INDEX_LATCH_LO[7:2], OFF_PLAT = ENC_QEI_PROBE_LATCH_LO[7:2],
+                    OFF_PRE = ENC_QEI_PRESET_LO[7:2], OFF_PRE_HI = ENC_QEI_PRESET_HI[7:2],
+                    OFF_CEIL = ENC_QEI_CEILING_LO[7:2], OFF_CEIL_HI = ENC_QEI_CEILING_HI[7:2];
 
   (* anyconst *) reg [3:0] f_ch;
   wire [AW-1:0] a_cnt = {f_ch, W_CNT}, a_pre = {f_ch, W_PRESET}, a_ceil = {f_ch, W_CEIL};
@@ -327,6 +334,8 @@ module enc_qei_engine_formal #(
   (* keep *) wire                p_ip_fresh; // eng.ip_fresh_q: c(v - 1) was fresh at its visit
   (* keep *) wire [1:0]          p_ip_pre;   // eng.ip_pre_q: its write's PRESET halves
   (* keep *) wire [1:0]          p_ip_ceil;  // eng.ip_ceil_q: ... CEILING halves
+  (* keep *) wire [31:0]         p_ip_data;  // eng.ip_data_q: ... its data
+  (* keep *) wire [31:0]         p_ip_lanes; // eng.ip_lanes_q: ... its byte lanes (bit mask)
   (* keep *) wire [NPEEK*64-1:0] p_peek;     // eng.u_mem.f_peek: the words of f_peek_addr
   (* keep *) wire [NPEEK*42-1:0] p_slot_pk;  // eng.u_pend.f_peek: word 0 is f's write slot
   (* keep *) wire [41:0]         p_n_pend;   // eng.n_pend: c(v + 1)'s write, as taken
@@ -351,36 +360,64 @@ module enc_qei_engine_formal #(
   reg  [63:0]      f_sto_d, f_scnt_d, f_ilat_d, f_plat_d;
   reg  [31:0]      f_exp;  // what the bus read of f under way answers
   reg              f_chk;  // ... one is under way, past its take
-  reg              f_pw_ok;  // the write in f's slot (or on its way there) is a COUNT_LO write
-  reg  [31:0]      f_pw;     // ... of this value (its bytes, the rest from COUNT as then read)
+  reg              f_pk;     // the write in f's slot (or on its way there) reaches a watched word
+  reg  [41:0]      f_px;     // ... and the slot holds this ({offset, byte enables, data}: a
+                             // COUNT_LO write whole, its bytes and COUNT as then read)
   reg  [31:0]      f_bcnt;   // COUNT_LO as read for a COUNT_LO write of f with some lanes off
-  reg              f_ld_ok;  // the read of the record loaded a COUNT_LO write (taken at its push)
-  reg  [31:0]      f_ld;     // ... of this value
-  wire [63:0]      f_ldb   = f_ld_ok ? {32'd0, f_ld} & SZ : PRE_RST;  // the anchor A_LOAD's value
-  wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, f_ldb, CEIL_RST, f_base, SZ);
-  wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
-  wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
-  wire [63:0]      f_pnew  = f_ppend ? lane_rebuild(f_pcap, f_panc, PRE_RST, CEIL_RST, f_base, SZ) : 64'd0;
+  reg              f_lk;     // the read of the record took such a write (at its push)
+  reg  [41:0]      f_lx;     // ... this one
+  reg  [63:0]      f_pre, f_ceil;    // PRESET and CEILING as stored (f's write-back writes them)
+  reg  [63:0]      f_vpre, f_vceil;  // ... at f's visit (the rebuild's)
+  reg  [63:0]      f_pre_d, f_ceil_d;
+  wire             f_ld_ok = f_lk && f_lx[41:36] == OFF_CNT;  // a COUNT_LO write was loaded
+  wire [63:0]      f_ldb   = f_ld_ok ? {32'd0, f_lx[31:0]} & SZ : f_vpre;  // A_LOAD's value
+  wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, f_ldb, f_vceil, f_base, SZ);
+  wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
+  wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
+  wire [63:0]      f_pnew  = f_ppend ? lane_rebuild(f_pcap, f_panc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
   wire             f_fresh = |(p_fresh & (1 << f_ch));
   wire             f_wbv   = p_wr_on && p_cw == f_ch;                    // f's write-back visit
   wire             f_wb    = f_wbv && p_slot == 5'd0;                    // ... its count's slot
   wire             f_rd_now = p_slot == V - 1 && p_cn == f_ch;           // f's lane is read
   wire             f_calc  = p_slot == V - 1 && p_cp == f_ch;            // f's visit computes
   wire             f_bus   = p_b_take && !p_b_wr && p_b_ch == f_ch;
-  wire [5:0]       OFF_CNT = ENC_QEI_COUNT_LO[7:2], OFF_SCNT = ENC_QEI_SNAP_COUNT_LO[7:2],
-                   OFF_ILAT = ENC_QEI_INDEX_LATCH_LO[7:2], OFF_PLAT = ENC_QEI_PROBE_LATCH_LO[7:2];
   wire             f_watched = p_b_word == OFF_CNT || p_b_word == OFF_SCNT || p_b_word == OFF_ILAT ||
-                               p_b_word == OFF_PLAT;
+                               p_b_word == OFF_PLAT || p_b_word == OFF_PRE || p_b_word == OFF_CEIL;
   wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
-                              (p_b_word == OFF_ILAT) ? f_ilat_d : f_plat_d;
+                              (p_b_word == OFF_ILAT) ? f_ilat_d : (p_b_word == OFF_PLAT) ? f_plat_d :
+                              (p_b_word == OFF_PRE) ? f_pre_d : f_ceil_d;
+  wire [31:0]      f_word_rst = (p_b_word == OFF_PRE) ? PRE_RST[31:0] :
+                                (p_b_word == OFF_CEIL) ? CEIL_RST[31:0] : 32'd0;
 
-  // the registers besides COUNT_LO whose writes reach the count: not written on f
-  function count_reg;
+  // the register the proof leaves out: COUNT_HI (its stage), not written on f
+  function left_out;
     input [5:0] off;
     begin
-      count_reg = off == ENC_QEI_COUNT_HI[7:2] ||
-                  off == ENC_QEI_PRESET_LO[7:2] || off == ENC_QEI_PRESET_HI[7:2] ||
-                  off == ENC_QEI_CEILING_LO[7:2] || off == ENC_QEI_CEILING_HI[7:2];
+      left_out = off == ENC_QEI_COUNT_HI[7:2];
+    end
+  endfunction
+
+  // a write {offset, byte enables, data} of a watched word: COUNT_LO, PRESET, CEILING, with some
+  // byte enable (a write of none changes nothing)
+  function watched_w;
+    input [41:0] w;
+    begin
+      watched_w = |w[35:32] && (w[41:36] == OFF_CNT || w[41:36] == OFF_PRE ||
+                                w[41:36] == OFF_PRE_HI || w[41:36] == OFF_CEIL ||
+                                w[41:36] == OFF_CEIL_HI);
+    end
+  endfunction
+
+  // a 64-bit word (PRESET, CEILING: lo at offset lo) after the write w of its half, kept to SZ
+  function [63:0] wide_merge;
+    input [63:0] c;
+    input [41:0] w;
+    input [5:0]  lo;
+    reg   [63:0] m;
+    begin
+      m = (w[41:36] == lo) ? {32'd0, lanes_of(w[35:32])} :
+          (w[41:36] == lo + 6'd1) ? {lanes_of(w[35:32]), 32'd0} : 64'd0;
+      wide_merge = ((c & ~m) | ({w[31:0], w[31:0]} & m)) & SZ;
     end
   endfunction
 
@@ -391,21 +428,20 @@ module enc_qei_engine_formal #(
     end
   endfunction
 
-  // a write, {offset, byte enables, data}, as a write slot holds it: a COUNT_LO write (with some
-  // byte enable) of f's value f_pw when ok, else a write of no register that reaches the count
+  // a write, {offset, byte enables, data}, as a write slot holds it: the watched write x when ok,
+  // else a write that reaches no watched word
   function slot_ok;
     input [41:0] w;
     input        ok;
-    input [31:0] v;
+    input [41:0] x;
     begin
-      slot_ok = !count_reg(w[41:36]) &&
-                ((w[41:36] == OFF_CNT && |w[35:32]) ? (ok && w[35:32] == 4'hF && w[31:0] == v) : !ok);
+      slot_ok = !left_out(w[41:36]) && (watched_w(w) ? (ok && w == x) : !ok);
     end
   endfunction
 
   always @(*) begin
     assume (f_ch < CHANNELS);
-    if (req_valid && req_write && req_ch == f_ch) assume (!count_reg(req_word));
+    if (req_valid && req_write && req_ch == f_ch) assume (!left_out(req_word));
   end
 
   always @(posedge clk) begin
@@ -413,6 +449,8 @@ module enc_qei_engine_formal #(
     f_scnt_d <= f_scnt;
     f_ilat_d <= f_ilat;
     f_plat_d <= f_plat;
+    f_pre_d  <= f_pre;
+    f_ceil_d <= f_ceil;
     if (rst) begin
       {f_lo, f_anc, f_spend, f_scap, f_sanc, f_ipend, f_icap, f_ianc, f_ppend, f_pcap, f_panc} <= 0;
       f_sto  <= 64'd0;
@@ -421,12 +459,14 @@ module enc_qei_engine_formal #(
       f_ilat <= 64'd0;
       f_plat <= 64'd0;
       f_chk  <= 1'b0;
-      f_ld_ok <= 1'b0;
-      f_pw_ok <= 1'b0;
+      f_lk   <= 1'b0;
+      f_pk   <= 1'b0;
+      f_pre  <= PRE_RST;
+      f_ceil <= CEIL_RST;
     end else begin
       if (f_rd_now) begin
-        f_ld_ok <= p_n_taken && f_pw_ok;
-        f_ld    <= f_pw;
+        f_lk    <= p_n_taken && f_pk;
+        f_lx    <= f_px;
         f_lo    <= p_rec_or[R_LO +: R_LO_W];
         f_anc   <= p_rec_or[R_ANC +: R_ANC_W];
         f_spend <= p_rec_or[R_SPEND];
@@ -439,18 +479,27 @@ module enc_qei_engine_formal #(
         f_pcap  <= p_rec_or[R_PLO +: R_PLO_W];
         f_panc  <= p_rec_or[R_PANC +: R_PANC_W];
       end
-      if (f_calc) f_base <= f_sto;
+      if (f_calc) begin
+        f_base  <= f_sto;
+        f_vpre  <= f_pre;
+        f_vceil <= f_ceil;
+      end
+      // PRESET and CEILING: f's write-back writes the write its visit took (slots 4, 5)
+      if (f_wbv && p_slot == 5'd4 && f_lk) f_pre <= wide_merge(f_pre, f_lx, OFF_PRE);
+      if (f_wbv && p_slot == 5'd5 && f_lk) f_ceil <= wide_merge(f_ceil, f_lx, OFF_CEIL);
       if (f_wb) f_sto <= f_new;
       if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
       if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
       if (f_wbv && p_slot == S_PLATCH && (f_ppend || f_fresh)) f_plat <= f_pnew;
       if (p_b_take && p_b_wr && p_b_ch == f_ch) f_bcnt <= f_fresh ? 32'd0 : f_sto_d[31:0];
       if (p_b_st == B_POST && p_b_ch == f_ch) begin
-        f_pw_ok <= p_b_word == OFF_CNT && |p_b_wstrb;
-        f_pw    <= (f_bcnt & ~lanes_of(p_b_wstrb)) | (p_b_wdata & lanes_of(p_b_wstrb));
+        f_pk <= watched_w({p_b_word, p_b_wstrb, p_b_wdata});
+        f_px <= (p_b_word == OFF_CNT) ?
+                {OFF_CNT, 4'hF, (f_bcnt & ~lanes_of(p_b_wstrb)) | (p_b_wdata & lanes_of(p_b_wstrb))} :
+                {p_b_word, p_b_wstrb, p_b_wdata};
       end
       if (f_bus && f_watched) begin
-        f_exp <= f_fresh ? 32'd0 : f_word_d[31:0];
+        f_exp <= f_fresh ? f_word_rst : f_word_d[31:0];
         f_chk <= 1'b1;
       end else if (resp_valid) begin
         f_chk <= 1'b0;
@@ -483,45 +532,55 @@ module enc_qei_engine_formal #(
 
   always @(*) begin
     if (f_past && !rst) begin
-      // a write of f (of a register that does not reach the count) on its way: the bus's
-      // request, f's write slot while the write waits or is applied, the write as taken for the
-      // push (slot 10 on), at the visit, and as a state write (slot 22 on)
-      // A COUNT_LO write of f carries its bytes and, in the others, COUNT as read at the write
-      // (when some are off) to f's read after its push, whose rebuild takes it as the value of
-      // the anchor A_LOAD.
-      if (p_b_st != B_IDLE && p_b_ch == f_ch && p_b_wr) assert (!count_reg(p_b_word));
+      // a write of f on its way: the bus's request, f's write slot while the write waits or is
+      // applied, the write as taken for the push (slot 10 on), at the visit, and as a state write
+      // (slot 22 on). A write of COUNT_LO, PRESET or CEILING is the one the wrapper keeps (f_px):
+      // COUNT_LO's with its bytes and, in the others, COUNT as read at the write (when some are
+      // off), to f's read after its push, whose rebuild takes it as the value of the anchor
+      // A_LOAD; PRESET's and CEILING's as written, to f's write-back. Any other write is none of
+      // them.
+      if (p_b_st != B_IDLE && p_b_ch == f_ch && p_b_wr) assert (!left_out(p_b_word));
       if (p_b_st == B_POST && p_b_ch == f_ch && p_b_wr && p_b_word == OFF_CNT && |p_b_wstrb &&
           !(&p_b_wstrb)) assert (p_b_cnt == f_bcnt);
-      if (p_pend_we && p_pend_wch == f_ch) assert (slot_ok(p_pend_wd, f_pw_ok, f_pw));
-      if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pw_ok, f_pw));
-      if (|(p_pend & p_pend_st & (1 << f_ch))) assert (!f_pw_ok);  // (a state write: not COUNT_LO)
-      if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pw_ok, f_pw));
+      if (p_pend_we && p_pend_wch == f_ch) assert (slot_ok(p_pend_wd, f_pk, f_px));
+      if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pk, f_px));
+      if (|(p_pend & p_pend_st & (1 << f_ch))) assert (!f_pk);  // (a state write: none of them)
+      if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pk, f_px));
       if (p_cp == f_ch) begin
-        assert (p_p_taken ? slot_ok(p_p_pend, f_ld_ok, f_ld) : !f_ld_ok);
-        if (p_slot >= V - 2 && p_e_taken) assert (!f_pw_ok);
-        if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, 1'b0, 32'd0));
+        assert (p_p_taken ? slot_ok(p_p_pend, f_lk, f_lx) : !f_lk);
+        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk);
+        if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, 1'b0, 42'd0));
       end
       // the count word of f: written whole in slot 0 of each of f's write-backs (always pending)
       stored_word(a_cnt, 5'd0, 1'b1, f_new, m_cnt, f_sto, p_n_cnt, 1'b1);
-      // PRESET and CEILING of f: written only with their reset values
-      if (p_we && p_waddr == a_pre) assert (((p_wdata ^ PRE_RST) & p_wmask & SZ) == 64'd0);
-      if (p_we && p_waddr == a_ceil) assert (((p_wdata ^ CEIL_RST) & p_wmask & SZ) == 64'd0);
-      // the memory: from f's write-back of each word on (its first one), or f no longer fresh
-      if (!f_fresh || (f_wbv && p_slot >= 5'd5)) assert ((m_pre & SZ) == PRE_RST);
-      if (!f_fresh || (f_wbv && p_slot >= 5'd6)) assert ((m_ceil & SZ) == CEIL_RST);
-      assert ((f_sto & ~SZ) == 64'd0);
+      // PRESET and CEILING of f: written only in their slots of f's write-back; the memory holds
+      // them from then on (or while f is not fresh), within SZ; the reset values before
+      if (p_we && p_waddr == a_pre) assert (f_wbv && p_slot == 5'd4);
+      if (p_we && p_waddr == a_ceil) assert (f_wbv && p_slot == 5'd5);
+      if (!f_fresh || (f_wbv && p_slot >= 5'd5)) assert (m_pre == f_pre);
+      else assert (f_pre == PRE_RST);
+      if (!f_fresh || (f_wbv && p_slot >= 5'd6)) assert (m_ceil == f_ceil);
+      else assert (f_ceil == CEIL_RST);
+      assert ((f_sto & ~SZ) == 64'd0 && (f_pre & ~SZ) == 64'd0 && (f_ceil & ~SZ) == 64'd0);
       stored_word(a_scnt, S_SCNT, f_spend, f_snew, m_scnt, f_scnt, p_n_scnt, p_n_snap);
       stored_word(a_ilat, S_ILATCH, f_ipend, f_inew, m_ilat, f_ilat, p_n_ilat, p_n_latch);
       stored_word(a_plat, S_PLATCH, f_ppend, f_pnew, m_plat, f_plat, p_n_plat, p_n_probe);
       // (f is fresh until the end of slot 19 of its first write-back; the first visit writes nothing)
       if (f_wbv && p_slot >= 5'd20) assert (!f_fresh);
       if (!p_wr_on) assert (p_cp == 4'd0 && f_fresh && f_sto == 64'd0);
-      // f's write-back writes PRESET and CEILING whole while f is fresh, else not at all; the
-      // count at the read before is the one its visit rebuilt from
+      // f's write-back: fresh as f was at the visit; PRESET's and CEILING's halves, data and byte
+      // lanes those of the write the visit took; the count at the read before is the one its
+      // visit rebuilt from
       if (f_wbv) begin
         if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
-        assert (p_ip_pre == 2'd0 && p_ip_ceil == 2'd0);
+        assert (p_ip_pre == {f_lk && f_lx[41:36] == OFF_PRE_HI, f_lk && f_lx[41:36] == OFF_PRE});
+        assert (p_ip_ceil == {f_lk && f_lx[41:36] == OFF_CEIL_HI, f_lk && f_lx[41:36] == OFF_CEIL});
+        if (|p_ip_pre || |p_ip_ceil)
+          assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
         if (p_slot == 5'd0) assert (f_base == f_sto);
+        // PRESET and CEILING as the visit had them, then with its write
+        assert (f_pre == ((p_slot >= 5'd5 && f_lk) ? wide_merge(f_vpre, f_lx, OFF_PRE) : f_vpre));
+        assert (f_ceil == ((p_slot >= 5'd6 && f_lk) ? wide_merge(f_vceil, f_lx, OFF_CEIL) : f_vceil));
       end
       // f's visit: the record of its read, the loads of the stored words
       if (p_cp == f_ch) begin
@@ -533,11 +592,11 @@ module enc_qei_engine_formal #(
         assert (p_rec_q[R_PPEND] == f_ppend && p_rec_q[R_PLO +: R_PLO_W] == f_pcap &&
                 p_rec_q[R_PANC +: R_PANC_W] == f_panc);
         if (p_slot >= 5'd12) assert (p_o_cnt == f_sto);
-        if (p_slot >= 5'd19) assert (p_o_pre == PRE_RST);
-        if (p_slot >= 5'd20) assert (p_o_ceil == CEIL_RST);
+        if (p_slot >= 5'd19) assert (p_o_pre == f_pre);
+        if (p_slot >= 5'd20) assert (p_o_ceil == f_ceil);
       end
-      // the bus: a read of f's COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO or PROBE_LATCH_LO answers
-      // the word as stored in the clock of its port-b read
+      // the bus: a read of f's COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO, PROBE_LATCH_LO, PRESET_LO
+      // or CEILING_LO answers the word as stored in the clock of its port-b read
       if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
                          p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
       if (f_chk && resp_valid) assert (resp_rdata == f_exp);
