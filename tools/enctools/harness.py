@@ -189,7 +189,19 @@ def build(s: RunSpec):
                          log_file=d / "build.log" if s.quiet else None)
             stamp.write_text(s.key() + "\n")
             built = True
+            if s.sim == "verilator":
+                _prune_verilator(d)
     return runner, built
+
+
+def _prune_verilator(d: Path) -> None:
+    """Delete a finished Verilator build's intermediates (its precompiled headers alone are
+    150 MB; a `make test` makes dozens of builds): the object files, archives and headers Vtop
+    was linked from. A build directory is never built again (its name holds the key of what
+    it is made of), so only the executable and the files beside it are used from here on."""
+    for pattern in ("*.gch", "*.o", "*.a"):
+        for f in d.glob(pattern):
+            f.unlink()
 
 
 def run(toplevel: str, test_module: str, name: str, parameters: dict | None = None,
