@@ -233,7 +233,7 @@ def build_gateware(cfg: SocConfig, force: bool = False) -> float:
 
 
 def _prune(cfg: SocConfig) -> None:
-    """Delete what a built SoC no longer needs, about 0.65 of its 0.7 GB: the simulator's object
+    """Delete what a built SoC no longer needs, about 0.55 of its 0.68 GB: the simulator's object
     files and precompiled headers (obj_dir/ but Vsim) and picolibc's objects and intermediate
     archives (the firmware links libc.a and includes picolibc.h). A rebuild (a new gateware key)
     makes them again: meson keeps its configuration and compiles afresh."""
