@@ -197,9 +197,9 @@ def build(s: RunSpec):
 def _prune_verilator(d: Path) -> None:
     """Delete a finished Verilator build's intermediates (its precompiled headers alone are
     150 MB; a `make test` makes dozens of builds): the precompiled headers, object files and
-    archives Vtop was made from. A build directory is never built again (its name holds the key
-    of what it is made of), so only the executable and the files beside it are used from here
-    on."""
+    archives its executable (named after the top level) was made from. A build directory is
+    never built again (its name holds the key of what it is made of), so only the executable and
+    the files beside it are used from here on."""
     for pattern in ("*.gch", "*.o", "*.a"):
         for f in d.glob(pattern):
             f.unlink()
