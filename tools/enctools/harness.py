@@ -190,19 +190,10 @@ def build(s: RunSpec):
             stamp.write_text(s.key() + "\n")
             built = True
             if s.sim == "verilator":
-                _prune_verilator(d)
+                # (a build directory is never built again: its name holds the key of what it is
+                # made of; a `make test` makes dozens, 75 MB each unpruned)
+                toolenv.prune_verilator_build(d)
     return runner, built
-
-
-def _prune_verilator(d: Path) -> None:
-    """Delete a finished Verilator build's intermediates (its precompiled headers alone are
-    150 MB; a `make test` makes dozens of builds): the precompiled headers, object files and
-    archives its executable (named after the top level) was made from. A build directory is
-    never built again (its name holds the key of what it is made of), so only the executable and
-    the files beside it are used from here on."""
-    for pattern in ("*.gch", "*.o", "*.a"):
-        for f in d.glob(pattern):
-            f.unlink()
 
 
 def run(toplevel: str, test_module: str, name: str, parameters: dict | None = None,

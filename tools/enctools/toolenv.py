@@ -64,3 +64,12 @@ def simulator_env() -> dict[str, str]:
 def apply() -> None:
     """Put :func:`simulator_env` into os.environ (idempotent)."""
     os.environ.update(simulator_env())
+
+
+def prune_verilator_build(d: Path) -> None:
+    """Delete what a finished Verilator build was made from and its runs never use: the
+    precompiled headers (150 MB a build), object files and archives in ``d``; the executable
+    stays. Only for a build that is not made again in ``d`` (a rebuild starts afresh)."""
+    for pattern in ("*.gch", "*.o", "*.a"):
+        for f in d.glob(pattern):
+            f.unlink()
