@@ -45,7 +45,8 @@ Options:
                      from rtl/, so ENGINE=0 picks the per-channel rows); as --only
   --update           with --only or --param: the rows built replace theirs in the table file, the
                      other rows are kept from it as they are (rows of a table with other columns
-                     keep the columns they have, "-" for the rest)
+                     keep the columns they have, "-" for the rest); the edge FIFO section under it
+                     is computed again from the whole table
   --seeds N          at most N nextpnr seeds per row (seeds 1..N; the seeds column says how many a
                      row had): a first figure of a long row, whose other seeds a later run adds
   --jobs N           parallel tool runs (default 2)
@@ -283,10 +284,10 @@ def main() -> int:
             RESULTS_MD.write_text(markdown(ordered))
             print(f"\nsynth: table written to {RESULTS_MD.relative_to(TOP)}")
         elif args.update:
-            kept, efifo = kept_rows(RESULTS_MD)
+            kept = kept_rows(RESULTS_MD)
             rows = [results[b.key] if b.key in results else kept.get((b.name, b.param_text, b.part))
                     for b in BLOCKS]
-            RESULTS_MD.write_text(markdown([r for r in rows if r is not None], efifo))
+            RESULTS_MD.write_text(markdown([r for r in rows if r is not None]))
             print(f"\nsynth: {len(ordered)} row(s) of {RESULTS_MD.relative_to(TOP)} replaced, "
                   f"{sum(1 for r in rows if isinstance(r, dict))} kept from it")
     if sweep:

@@ -4,6 +4,7 @@ that differ from the table a run replaces."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .blocks import (BLOCK_DEVICE_NAME, BOARD_CLOCK_MHZ, BRAM_CAPACITY, BRAM_CELL, CAPACITY, CHANNELS_MD,
@@ -87,37 +88,67 @@ def table(results: list[Result | dict]) -> str:
     return "\n".join(rows)
 
 
+def row_figures(r: Result | dict) -> dict | None:
+    """A row's figures for the FIFO table, from a Result or from a row kept from the table file:
+    module, part, parameters (name -> text), LUT4, FF, block RAM and distributed RAM counts, Fmax
+    (text), or None for a row without figures (not built, not synthesised)."""
+    if isinstance(r, Result):
+        if r.status != "ok":
+            return None
+        b = r.block
+        return {"module": b.name, "part": b.part, "params": {k: str(v) for k, v in b.params.items()},
+                "luts": r.luts, "ffs": r.ffs, "brams": r.brams, "lutrams": r.lutrams,
+                "fmax": f"{r.fmax:.1f}" if r.fmax is not None else "-"}
+    if not (r.get("LUT4", "").isdigit() and r.get("FF", "").isdigit()):
+        return None
+    params = dict(p.split("=", 1) for p in r.get("params", "-").split(", ") if "=" in p)
+    ram = r.get("block RAM", "-")
+    brams = re.search(r"(\d+) (?:SB_RAM40_4K|DP16KD)", ram)
+    lutrams = re.search(r"(\d+) DPR16X4", ram)
+    if brams is None:  # rows written before the block RAM column: "...; 3 SB_RAM40" in the result
+        brams = re.search(r"(\d+) SB_RAM40", r.get("result", ""))
+    fmax = re.match(r"\d+\.\d+", r.get("Fmax (MHz)", ""))
+    return {"module": r.get("module", "-"), "part": r.get("part", "-"), "params": params,
+            "luts": int(r["LUT4"]), "ffs": int(r["FF"]), "brams": int(brams.group(1)) if brams else 0,
+            "lutrams": int(lutrams.group(1)) if lutrams else 0, "fmax": fmax.group(0) if fmax else "-"}
+
+
 def efifo_table(results: list[Result | dict]) -> list[str]:
     """The edge FIFO's cost: each row with EFIFO_LOG2 against the row of the same build without
-    it (LUT4, FF and block RAM over it, and its Fmax), from the rows measured by this run."""
-    results = [r for r in results if isinstance(r, Result)]
-    ok = {(r.block.name, r.block.device, tuple(sorted(r.block.params.items()))): r
-          for r in results if r.status == "ok"}
+    it (LUT4, FF and RAM over it, and its Fmax). `results` is the whole table (rows measured by
+    this run and rows kept from the table file alike), so a run that replaces some rows writes the
+    section for all of them."""
+    figs = [f for f in map(row_figures, results) if f is not None]
+    key = lambda f, params: (f["module"], f["part"], tuple(sorted(params.items())))  # noqa: E731
+    base_of = {key(f, f["params"]): f for f in figs}
     rows = []
-    for r in results:
-        log2 = r.block.params.get("EFIFO_LOG2")
-        if r.status != "ok" or not log2:
+    for f in figs:
+        log2 = f["params"].get("EFIFO_LOG2")
+        if not log2 or log2 == "0":
             continue
-        base_params = tuple(sorted((k, v) for k, v in r.block.params.items() if k != "EFIFO_LOG2"))
-        base = ok.get((r.block.name, r.block.device, base_params))
+        base = base_of.get(key(f, {k: v for k, v in f["params"].items() if k != "EFIFO_LOG2"}))
         if base is None:
             continue
-        fmax = f"{r.fmax:.1f}" if r.fmax is not None else "-"
-        bfmax = f"{base.fmax:.1f}" if base.fmax is not None else "-"
-        rows.append(f"| {r.block.name} | {base.block.param_text} | {1 << log2} | {r.luts} | "
-                    f"{r.luts - base.luts:+d} | {r.ffs - base.ffs:+d} | {r.brams - base.brams:+d} | "
-                    f"{fmax} (without: {bfmax}) |")
+        ram = [f"{f['brams'] - base['brams']:+d}"]
+        if f["lutrams"] or base["lutrams"]:
+            ram.append(f"{f['lutrams'] - base['lutrams']:+d} DPR16X4")
+        params = ", ".join(f"{k}={v}" for k, v in f["params"].items() if k != "EFIFO_LOG2") or "-"
+        rows.append(f"| {f['module']} | {params} | {f['part']} | {1 << int(log2)} | {f['luts']} | "
+                    f"{f['luts'] - base['luts']:+d} | {f['ffs'] - base['ffs']:+d} | {', '.join(ram)} | "
+                    f"{f['fmax']} (without: {base['fmax']}) |")
     if not rows:
         return []
-    return ["", "Edge-capture FIFO (EFIFO_LOG2): the cost of one channel's FIFO, against the same build "
-            "without it (rows above).", "",
-            "| module | params | entries | LUT4 | LUT4 for the FIFO | FF for it | SB_RAM40 for it | Fmax (MHz) |",
-            "|---|---|---:|---:|---:|---:|---:|---|", *rows]
+    return ["", "Edge-capture FIFO (EFIFO_LOG2): the cost of the FIFOs (one per channel), against the "
+            "same build without them (rows above). Block RAM for them: SB_RAM40_4K (HX8K) or DP16KD "
+            "(ECP5), and the ECP5's DPR16X4.", "",
+            "| module | params | part | entries | LUT4 | LUT4 for the FIFOs | FF for them | block RAM for them "
+            "| Fmax (MHz) |",
+            "|---|---|---|---:|---:|---:|---:|---|---|", *rows]
 
 
-def markdown(results: list[Result | dict], efifo: list[str] | None = None) -> str:
-    """The table file; `efifo`: the FIFO section kept from the table file when this run measured
-    none of its rows."""
+def markdown(results: list[Result | dict]) -> str:
+    """The table file: the rows (measured, or kept from the file by --update) and the FIFO section
+    computed from all of them."""
     return "\n".join([
         "<!-- generated by scripts/synth.py (`make synth`); do not edit by hand -->",
         "Yosys `synth_ice40` + nextpnr-ice40 (yowasp builds pinned in requirements.txt), nextpnr "
@@ -141,7 +172,7 @@ def markdown(results: list[Result | dict], efifo: list[str] | None = None) -> st
         f"[{CHANNELS_MD.name}]({CHANNELS_MD.name}).",
         "",
         table(results),
-        *(efifo_table(results) or efifo or []),
+        *efifo_table(results),
         "",
     ])
 
@@ -149,24 +180,22 @@ def markdown(results: list[Result | dict], efifo: list[str] | None = None) -> st
 # ------------------------------------------------------------------------------------------------
 # the table a run replaces
 # ------------------------------------------------------------------------------------------------
-def kept_rows(path: Path) -> tuple[dict[tuple[str, str, str], dict], list[str]]:
+def kept_rows(path: Path) -> dict[tuple[str, str, str], dict]:
     """The table file's rows, (module, params, part) -> column name -> cell (by the file's own
-    header, so a row of a table with other columns keeps what it has), and its edge FIFO section
-    (the lines from its blank line before "Edge-capture FIFO" on)."""
+    header, so a row of a table with other columns keeps what it has). The edge FIFO section is
+    not kept: markdown() computes it again from the whole table."""
     rows: dict[tuple[str, str, str], dict] = {}
     if not path.exists():
-        return rows, []
+        return rows
     lines = path.read_text().splitlines()
     head = next((split_row(l) for l in lines if l.startswith("| module |")), [])
     for line in lines:
+        if line.startswith("Edge-capture FIFO"):
+            break  # the FIFO table: its rows are not results rows
         cols = split_row(line)
         if head and len(cols) == len(head) and cols != head and not set(cols[0]) <= set("-:"):
             rows.setdefault((cols[0], cols[1], cols[2]), dict(zip(head, cols)))
-        if line.startswith("| module | params | entries"):
-            break  # the FIFO table: its rows are not results rows
-    start = next((i for i, l in enumerate(lines) if l.startswith("Edge-capture FIFO")), None)
-    efifo = [""] + "\n".join(lines[start:]).rstrip().splitlines() if start is not None else []
-    return rows, efifo
+    return rows
 
 
 def split_row(line: str) -> list[str]:
