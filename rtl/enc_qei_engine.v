@@ -260,6 +260,7 @@ module enc_qei_engine #(
   //   W_CNT    the count (COUNT_W bits)
   //   W_CFG    [31:0] CTRL, [40:32] INDEX_CTRL, [44:41] SNAP_CTRL, [58:45] IRQ_EN, [61:59] PROBE_CTRL
   //   W_UD     [31:0] the unit timer's next time (SNAP_CTRL.PERIOD_EN), [63:32] tv of the last read
+  //            (read by the unit timer, the stall timer and period capture only: 0 without PERIOD)
   //   W_PCTL   [17:0] PERIOD_CTRL, [18] a measurement runs, [19] ... overflowed, [63:32] its start
   //   W_PRESET, W_CEIL, W_CMP   PRESET, CEILING, COMPARE
   //   W_TMO    [31:0] SNAP_PERIOD, [63:32] STALL_TIMEOUT
@@ -271,7 +272,11 @@ module enc_qei_engine #(
   //   W_SCNT   SNAP_COUNT; W_STIME [31:0] SNAP_TIME, [63:32] SNAP_EDGE_TIME;
   //   W_SDELTA [31:0] SNAP_DELTA, [63:32] SNAP_EDGE_DELTA; W_ILATCH INDEX_LATCH; W_PLATCH
   //            PROBE_LATCH; W_PTIME [31:0] PROBE_TIME, [63:32] PERIOD
-  //   W_STL    [32:0] ticks since the stall timer's last restart at the last read (clamped)
+  //   W_STL    [32:0] ticks since the stall timer's last restart at the last read (clamped; 0
+  //            without PERIOD)
+  // The words of a unit the build leaves out are written and loaded as constants (W_UD and W_STL
+  // written 0; the loads below): read back from the memory, synthesis could not see that the
+  // arithmetic on them is unused, and would keep it.
   localparam [4:0] W_CNT = 5'd0, W_CFG = 5'd1, W_UD = 5'd2, W_PCTL = 5'd3, W_PRESET = 5'd4,
                    W_CEIL = 5'd5, W_CMP = 5'd6, W_TMO = 5'd7, W_HI = 5'd8, W_MOT = 5'd9,
                    W_EVT = 5'd10, W_EDGE = 5'd11, W_SBASE = 5'd12, W_SCNT = 5'd13, W_STIME = 5'd14,
@@ -462,16 +467,22 @@ module enc_qei_engine #(
   // changes in slot 19, for c(v - 1), which is c(v + 1) only once it is written: then n_fresh is
   // 0 all along), so the reset value is loaded into the register itself: on the iCE40 and the
   // ECP5 a flip-flop's synchronous set / reset, not a multiplexer after it.
+  // A word of a unit the build leaves out (RANGE: CEILING, COMPARE; PERIOD: W_UD, W_PCTL, W_TMO)
+  // is loaded as its reset value: the memory holds nothing else for it (its writes are not taken,
+  // see CTRL_WR .. PERC_WR; W_UD and W_STL are written 0), and a constant leaves out the
+  // arithmetic on it, which synthesis cannot see through the memory.
+  localparam integer NO_RANGE = (RANGE == 0) ? 1 : 0, NO_PERIOD = (PERIOD == 0) ? 1 : 0;
+
   always @(posedge clk) begin
     case (slot_q)
       5'd2:  n_cnt   <= n_fresh ? 64'd0 : rdata_a;
       5'd3:  n_cfg   <= n_fresh ? CFG_RST : rdata_a;
-      5'd4:  n_ud    <= rdata_a;  // (used only when the channel is not fresh)
-      5'd5:  n_pctl  <= n_fresh ? PCTL_RST : rdata_a;
+      5'd4:  n_ud    <= (NO_PERIOD != 0) ? 64'd0 : rdata_a;  // (used only when the channel is not fresh)
+      5'd5:  n_pctl  <= (n_fresh || NO_PERIOD != 0) ? PCTL_RST : rdata_a;
       5'd6:  n_pre   <= n_fresh ? PRE_RST : rdata_a;
-      5'd7:  n_ceil  <= n_fresh ? CEIL_RST : rdata_a;
-      5'd8:  n_cmp   <= n_fresh ? CMP_RST : rdata_a;
-      5'd9:  n_tmo   <= n_fresh ? TMO_RST : rdata_a;
+      5'd7:  n_ceil  <= (n_fresh || NO_RANGE != 0) ? CEIL_RST : rdata_a;
+      5'd8:  n_cmp   <= (n_fresh || NO_RANGE != 0) ? CMP_RST : rdata_a;
+      5'd9:  n_tmo   <= (n_fresh || NO_PERIOD != 0) ? TMO_RST : rdata_a;
       5'd10: n_hi    <= n_fresh ? 64'd0 : rdata_a;
       5'd11: o_cnt   <= p_fresh ? 64'd0 : rdata_a & SZ_COUNT;
       5'd12: o_mot   <= p_fresh ? 64'd0 : rdata_a;
@@ -481,10 +492,10 @@ module enc_qei_engine #(
       5'd16: o_hi    <= p_fresh ? 64'd0 : rdata_a;
       5'd17: o_cfg   <= p_fresh ? CFG_RST : rdata_a;
       5'd18: o_pre   <= p_fresh ? PRE_RST : rdata_a & SZ_COUNT;
-      5'd19: o_ceil  <= p_fresh ? CEIL_RST : rdata_a & SZ_COUNT;
-      5'd20: o_tmo   <= p_fresh ? TMO_RST : rdata_a;
-      5'd21: o_pctl  <= p_fresh ? PCTL_RST : rdata_a;
-      5'd22: o_ud    <= p_fresh ? 64'd0 : rdata_a;
+      5'd19: o_ceil  <= (p_fresh || NO_RANGE != 0) ? CEIL_RST : rdata_a & SZ_COUNT;
+      5'd20: o_tmo   <= (p_fresh || NO_PERIOD != 0) ? TMO_RST : rdata_a;
+      5'd21: o_pctl  <= (p_fresh || NO_PERIOD != 0) ? PCTL_RST : rdata_a;
+      5'd22: o_ud    <= (p_fresh || NO_PERIOD != 0) ? 64'd0 : rdata_a;
       default: ;
     endcase
   end
@@ -1061,7 +1072,7 @@ module enc_qei_engine #(
     if (slot_q == S_LAST) begin
       n_cnt_q    <= cnt_n;
       n_cfg_q    <= cfg_n;
-      n_ud_q     <= {tv, ud_n};
+      n_ud_q     <= (PERIOD != 0) ? {tv, ud_n} : 64'd0;  // (a build without PERIOD: 0, see W_UD)
       n_pctl_q   <= pctl_n;
       ip_data_q  <= w_data;
       ip_lanes_q <= w_mask;
@@ -1081,7 +1092,7 @@ module enc_qei_engine #(
       n_ilatch_q <= x_lpend ? rebuild(x_lcap, x_lanc, o_pre, o_ceil, o_cnt) : 64'd0;
       n_platch_q <= x_ppend ? rebuild(x_plo, x_panc, o_pre, o_ceil, o_cnt) : 64'd0;
       n_ptime_q  <= {pnb ? period_v : 32'd0, x_ppend ? tstamp(x_ptime, tv) : 32'd0};
-      n_stl_q    <= {31'd0, el_n};
+      n_stl_q    <= (PERIOD != 0) ? {31'd0, el_n} : 64'd0;
       n_snap_q   <= x_spend | p_fresh;  // (the first visit writes the reset values)
       n_latch_q  <= x_lpend | p_fresh;
       n_probe_q  <= x_ppend | p_fresh;
