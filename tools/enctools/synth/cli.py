@@ -43,6 +43,8 @@ Options:
   --param N=V ...    just the rows of the first table with these parameters (ENGINE=1: the
                      shared engine's rows; a row that does not set N has the module's default
                      from rtl/, so ENGINE=0 picks the per-channel rows); as --only
+  --device DEV       with --only or --param: just the rows of this part (hx8k: the iCE40 rows, the
+                     board top's UP5K included; ecp5)
   --update           with --only or --param: the rows built replace theirs in the table file, the
                      other rows are kept from it as they are (rows of a table with other columns
                      keep the columns they have, "-" for the rest); the edge FIFO section under it
@@ -212,6 +214,8 @@ def main() -> int:
                     help="synthesize only these modules' rows (no channel table)")
     ap.add_argument("--param", nargs="+", metavar="NAME=VALUE", type=parse_param, default=[],
                     help="only the rows with these parameters, e.g. ENGINE=1 (no channel table)")
+    ap.add_argument("--device", choices=("hx8k", "ecp5"),
+                    help="with --only or --param: only the rows of this part (hx8k: the iCE40 rows)")
     ap.add_argument("--update", action="store_true",
                     help="with --only or --param: these rows replace theirs in the table file, the others stay")
     ap.add_argument("--seeds", type=int, metavar="N",
@@ -236,6 +240,8 @@ def main() -> int:
     if picked and args.table in ("both", "channels"):
         ap.error("--only and --param pick rows of the first table; the channel table runs without them "
                  "(--table channels)")
+    if args.device and not picked:
+        ap.error("--device goes with --only or --param (it picks rows of the first table)")
     if args.update and (not picked or args.quick):
         ap.error("--update goes with --only or --param (a whole run rewrites the table file), not --quick")
     table_kind = args.table or ("blocks" if picked or args.quick else "both")
@@ -253,6 +259,10 @@ def main() -> int:
         blocks = [b for b in blocks if has_params(b, args.param)]
         if not blocks:
             ap.error("no row has " + ", ".join(f"{k}={v}" for k, v in args.param))
+    if args.device:
+        blocks = [b for b in blocks if (b.device == "ecp5") == (args.device == "ecp5")]
+        if not blocks:
+            ap.error(f"no row picked is of the {args.device}")
     if args.seeds is not None:
         if args.seeds < 1:
             ap.error(f"--seeds must be at least 1, not {args.seeds}")
