@@ -62,3 +62,14 @@ def test_partial_update_keeps_the_derived_section(tmp_path):
     differ = [(a, b) for a, b in zip(before, after) if a != b]
     assert len(differ) == 1, differ
     assert "ENGINE=1" in differ[0][0] and "HX8K" in differ[0][0]
+
+
+def test_previous_rows_are_the_results_rows():
+    """What a run compares its rows with (report.previous_rows): the results table's LUT4, not the
+    FIFO section's entries, whose rows share the module, params and part."""
+    from enctools.synth.report import previous_rows
+
+    before = previous_rows(RESULTS_MD)
+    for r in table_rows(RESULTS_MD):
+        if r["LUT4"].isdigit():
+            assert before[(r["module"], r["params"], r["part"])][0] == int(r["LUT4"])

@@ -208,6 +208,8 @@ def previous_rows(path: Path) -> dict[tuple[str, str, str], tuple[int, float | N
     if not path.exists():
         return out
     for line in path.read_text().splitlines():
+        if line.startswith("Edge-capture FIFO"):
+            break  # the FIFO table: its rows are not results rows
         cols = [c.strip() for c in line.strip().strip("|").split("|")]
         if len(cols) < 7 or not cols[3].isdigit():
             continue
