@@ -17,7 +17,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
 from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, engine_lag, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations
 from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
@@ -146,7 +146,10 @@ async def byte_enables(dut):
 
 @cocotb_test()
 async def register_walk(dut):
-    """Every register of the compiled RDL through the bus: offset, reset value, access."""
+    """Every register of the compiled RDL through the bus: offset, reset value, access. On the
+    shared engine a write acts, and a snapshot it requests (GSNAP_CTRL, SNAP_CTRL, their timers)
+    is taken, up to engine_lag clocks later: the walk waits that long after each register, so
+    that a read-only register (GSNAP_TIME, SNAP_*) it reads next holds still."""
     env, rng = await begin(dut)
     bus = env.bus
     caps = await bus.rd("CAPS")
@@ -154,6 +157,7 @@ async def register_walk(dut):
     assert (count_w, ts_w) == (env.count_w, int(dut.TS_W.value)), f"CAPS {caps:#x}"
     regs = sorted(regmap().values(), key=lambda r: r.offset)
     have = units(caps)
+    settle = engine_lag(int(dut.CHANNELS.value)) if env.engine else 0
 
     def fmask(f):
         return built_mask(f, count_w, ts_w, have)
@@ -195,6 +199,8 @@ async def register_walk(dut):
         # back to the reset value
         reset = sum((f.reset or 0) << f.lsb for f in r.fields.values()) & 0xFFFFFFFF
         await bus.wr(r.name, reset)
+        if settle:
+            await ClockCycles(dut.clk, settle)
     value = rng.getrandbits(64) & ((1 << count_w) - 1)
     await bus.set_count(value)
     assert await bus.count() == value, "COUNT_HI/COUNT_LO write then read"

@@ -19,7 +19,9 @@ the same, shown at once):
   its own model; channels isolated from each other's bus traffic; reset in mid-motion;
 - snapshots requested faster than the engine stores them: a global one waits for the captures of
   the one before (GSNAP_TIME tells when it was taken), a channel's own one waits for its visit
-  (SNAP_TIME tells), and SNAP_READY rises only when SNAP_* hold the snapshot.
+  (SNAP_TIME tells), and SNAP_READY rises only when SNAP_* hold the snapshot; a request that waits
+  when its source is stopped (GSNAP_CTRL.PERIOD_EN written 0) is still taken, at most P clocks
+  after the write's snapshot clock, and GSNAP_TIME holds still from P + 44 clocks after it.
 
 Runs on ENGINE_CONFIGS (enc_qei_wb, lean, COUNT_W 32, TS_W 32; 16 channels on Verilator whatever
 SIM says). Every cocotb test logs its seed.
@@ -770,6 +772,36 @@ async def snapshot_merge_defer(dut):
         counts[case] = counts.get(case, 0) + 1
     task.cancel()
     dut._log.info("request pairs: %s", counts)
+
+
+@cocotb_test()
+async def stop_keeps_a_waiting_snapshot(dut):
+    """The global unit timer at GSNAP_PERIOD 0 (a request every tick, faster than the engine
+    stores the captures), stopped by a GSNAP_CTRL write at a random clock: on the per-channel
+    build no snapshot comes after the write's snapshot clock; with the engine the request that
+    waits then is still taken (the RDL text of CAPS.ENGINE shared, (3)), at most P clocks after
+    that clock, and GSNAP_TIME holds still from P + 44 clocks after the write on."""
+    env, rng, envs, _ = await start_all(dut, index=False)
+    raw = WbRaw(dut)
+    p = engine_period(len(envs)) if env.engine else 0
+    late = 0
+    for trial in range(8):
+        await env.bus.wr("GSNAP_PERIOD", 0)
+        await env.bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
+        await ClockCycles(dut.clk, rng.randint(1, 3 * max(p, 8)))
+        w, _, _ = await raw.access(addr("GSNAP_CTRL"), 0)
+        stop = w + C_GSNAP  # the write's snapshot clock
+        await ClockCycles(dut.clk, p + ENGINE_SHOW)
+        g = await env.bus.rd("GSNAP_TIME")
+        await ClockCycles(dut.clk, 2 * p + ENGINE_SHOW)
+        assert await env.bus.rd("GSNAP_TIME") == g, \
+            f"trial {trial}: GSNAP_TIME changed more than P + {ENGINE_SHOW} clocks after the stop"
+        assert stop - max(p, 8) <= g <= stop + p, \
+            f"trial {trial}: the last timer snapshot at {g:#x}, the stop's snapshot clock {stop:#x} (P {p})"
+        late += g > stop
+    if env.engine:
+        assert late, "no snapshot after the stop: a waiting request was dropped"
+    dut._log.info("snapshots after the stop (a request that waited): %d of 8", late)
 
 
 @cocotb_test()
