@@ -238,6 +238,48 @@ async def stall_timeout_exact(dut):
     await bus.events()
 
 
+@cocotb_test(skip=lacks("PERIOD"))
+async def stall_ended_by_a_step(dut):
+    """A stall that the next step ends soon after: STALL_TIMEOUT t at PRESCALE 0 (t above what
+    the shared engine's lane times itself), a step, and the next one g clocks later, g from
+    t - 40 to t + 2 P + 40 (P: the engine's period; 0 per channel), so that with the engine the
+    stall and the step that ends it often fall between two of its reads of the channel, where it
+    must find the stall from the step's time. EVENTS.STALL is set when g > t + 2 and not when
+    g < t - 2; STATUS.STALLED is clear after the step."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    p = engine_period(int(dut.CHANNELS.value)) if env.engine else 0
+    stalled_lsb = regmap()["STATUS"].fields["STALLED"].lsb
+
+    async def step():
+        await FallingEdge(dut.clk)
+        env.pos += 1
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+
+    seen = {True: 0, False: 0}
+    for t in (0x1F0, 0x2A5, 0x1005):
+        await bus.wr("STALL_TIMEOUT", t)
+        await env.applied()
+        for trial in range(8):
+            g = rng.choice((rng.randint(t - 40, t - 3), rng.randint(t + 3, t + 2 * p + 40)))
+            await step()
+            await env.settle()  # less than t: no stall; the events of the trial before read out
+            await bus.events()
+            await step()
+            await ClockCycles(dut.clk, g - 1)
+            await step()
+            await env.settle()
+            got = "STALL" in await bus.events()
+            assert got == (g > t), f"STALL_TIMEOUT {t:#x}, the next step {g} clocks later: " \
+                f"EVENTS.STALL {int(got)}"
+            assert not (await bus.rd("STATUS")) >> stalled_lsb & 1, "STALLED after the step"
+            seen[g > t] += 1
+    dut._log.info("stalls ended by a step: %d, steps before the timeout: %d", seen[True], seen[False])
+    await bus.wr("STALL_TIMEOUT", 0)
+
+
 @cocotb_test()
 async def prescaler_long(dut):
     """TIMEBASE at PRESCALE values that set bits 0 .. 8, over 8 to 150 ticks (2,400 clocks or
