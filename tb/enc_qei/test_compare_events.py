@@ -214,6 +214,29 @@ async def error_counters_wide(dut):
     await bus.events()
 
 
+@cocotb_test()
+async def error_counters_saturate(dut):
+    """QERR_COUNT's top bit and its saturation at 0xFFFF ("Number of QERR events, saturating at
+    0xFFFF"): 32,770 illegal jumps read 32,770 (bit 15 set), 32,770 more read 0xFFFF, not the sum
+    modulo 2^16; a write clears it."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    n = 32770
+    await env.setup(model, func="x4", filter_len=1, count=0)
+    for want in (n, 0xFFFF):
+        await env.drv.play(walk([2] * n, [3 * T_NS] * n, start_pos=env.pos))
+        env.pos += 2 * n
+        await env.settle(10)
+        got = await bus.rd("QERR_COUNT")
+        assert got == want, f"QERR_COUNT {got:#x} after {want if want == n else 2 * n} illegal jumps, not {want:#x}"
+    await bus.wr("QERR_COUNT", 0)
+    await env.applied()
+    await env.settle(10)
+    assert await bus.rd("QERR_COUNT") == 0, "QERR_COUNT not cleared by a write"
+    await bus.events()
+
+
 @cocotb_test(skip=lacks("RANGE"))
 async def cmp_on_load(dut):
     """A COUNT load that makes the count equal COMPARE raises CMP and pulses cmp_out once, for one
