@@ -47,8 +47,8 @@ def test_every_fifo_row_has_its_base():
 
 def test_partial_update_keeps_the_derived_section(tmp_path):
     """What --update does (kept rows plus the replaced ones): replacing one engine row changes its
-    FIFO line and keeps every other one; an earlier fault wrote the section from the replaced rows
-    only."""
+    FIFO line and keeps every other one (a section written from the replaced rows alone would lose
+    the others)."""
     rows = table_rows(RESULTS_MD)
     before = [l for l in efifo_table(rows) if l.startswith("| enc_qei")]
     i = next(i for i, r in enumerate(rows) if "ENGINE=1" in r["params"] and "EFIFO_LOG2" not in r["params"]
