@@ -274,9 +274,7 @@ module enc_qei_engine #(
   //            PROBE_LATCH; W_PTIME [31:0] PROBE_TIME, [63:32] PERIOD
   //   W_STL    [32:0] ticks since the stall timer's last restart at the last read (clamped; 0
   //            without PERIOD)
-  // The words of a unit the build leaves out are written and loaded as constants (W_UD and W_STL
-  // written 0; the loads below): read back from the memory, synthesis could not see that the
-  // arithmetic on them is unused, and would keep it.
+  // (The words of a unit the build leaves out are loaded as constants: see the loads below.)
   localparam [4:0] W_CNT = 5'd0, W_CFG = 5'd1, W_UD = 5'd2, W_PCTL = 5'd3, W_PRESET = 5'd4,
                    W_CEIL = 5'd5, W_CMP = 5'd6, W_TMO = 5'd7, W_HI = 5'd8, W_MOT = 5'd9,
                    W_EVT = 5'd10, W_EDGE = 5'd11, W_SBASE = 5'd12, W_SCNT = 5'd13, W_STIME = 5'd14,
@@ -471,18 +469,16 @@ module enc_qei_engine #(
   // is loaded as its reset value: the memory holds nothing else for it (its writes are not taken,
   // see CTRL_WR .. PERC_WR; W_UD and W_STL are written 0), and a constant leaves out the
   // arithmetic on it, which synthesis cannot see through the memory.
-  localparam integer NO_RANGE = (RANGE == 0) ? 1 : 0, NO_PERIOD = (PERIOD == 0) ? 1 : 0;
-
   always @(posedge clk) begin
     case (slot_q)
       5'd2:  n_cnt   <= n_fresh ? 64'd0 : rdata_a;
       5'd3:  n_cfg   <= n_fresh ? CFG_RST : rdata_a;
-      5'd4:  n_ud    <= (NO_PERIOD != 0) ? 64'd0 : rdata_a;  // (used only when the channel is not fresh)
-      5'd5:  n_pctl  <= (n_fresh || NO_PERIOD != 0) ? PCTL_RST : rdata_a;
+      5'd4:  n_ud    <= (PERIOD == 0) ? 64'd0 : rdata_a;  // (read only when not fresh)
+      5'd5:  n_pctl  <= (n_fresh || PERIOD == 0) ? PCTL_RST : rdata_a;
       5'd6:  n_pre   <= n_fresh ? PRE_RST : rdata_a;
-      5'd7:  n_ceil  <= (n_fresh || NO_RANGE != 0) ? CEIL_RST : rdata_a;
-      5'd8:  n_cmp   <= (n_fresh || NO_RANGE != 0) ? CMP_RST : rdata_a;
-      5'd9:  n_tmo   <= (n_fresh || NO_PERIOD != 0) ? TMO_RST : rdata_a;
+      5'd7:  n_ceil  <= (n_fresh || RANGE == 0) ? CEIL_RST : rdata_a;
+      5'd8:  n_cmp   <= (n_fresh || RANGE == 0) ? CMP_RST : rdata_a;
+      5'd9:  n_tmo   <= (n_fresh || PERIOD == 0) ? TMO_RST : rdata_a;
       5'd10: n_hi    <= n_fresh ? 64'd0 : rdata_a;
       5'd11: o_cnt   <= p_fresh ? 64'd0 : rdata_a & SZ_COUNT;
       5'd12: o_mot   <= p_fresh ? 64'd0 : rdata_a;
@@ -492,10 +488,10 @@ module enc_qei_engine #(
       5'd16: o_hi    <= p_fresh ? 64'd0 : rdata_a;
       5'd17: o_cfg   <= p_fresh ? CFG_RST : rdata_a;
       5'd18: o_pre   <= p_fresh ? PRE_RST : rdata_a & SZ_COUNT;
-      5'd19: o_ceil  <= (p_fresh || NO_RANGE != 0) ? CEIL_RST : rdata_a & SZ_COUNT;
-      5'd20: o_tmo   <= (p_fresh || NO_PERIOD != 0) ? TMO_RST : rdata_a;
-      5'd21: o_pctl  <= (p_fresh || NO_PERIOD != 0) ? PCTL_RST : rdata_a;
-      5'd22: o_ud    <= (p_fresh || NO_PERIOD != 0) ? 64'd0 : rdata_a;
+      5'd19: o_ceil  <= (p_fresh || RANGE == 0) ? CEIL_RST : rdata_a & SZ_COUNT;
+      5'd20: o_tmo   <= (p_fresh || PERIOD == 0) ? TMO_RST : rdata_a;
+      5'd21: o_pctl  <= (p_fresh || PERIOD == 0) ? PCTL_RST : rdata_a;
+      5'd22: o_ud    <= (p_fresh || PERIOD == 0) ? 64'd0 : rdata_a;
       default: ;
     endcase
   end

@@ -15,7 +15,7 @@ import copy
 from pathlib import Path
 
 from enctools.synth.blocks import BLOCKS, RESULTS_MD
-from enctools.synth.report import efifo_table, kept_rows, markdown
+from enctools.synth.report import efifo_table, kept_rows, markdown, previous_rows
 
 TOP = Path(__file__).resolve().parents[2]
 
@@ -67,8 +67,6 @@ def test_partial_update_keeps_the_derived_section(tmp_path):
 def test_previous_rows_are_the_results_rows():
     """What a run compares its rows with (report.previous_rows): the results table's LUT4, not the
     FIFO section's entries, whose rows share the module, params and part."""
-    from enctools.synth.report import previous_rows
-
     before = previous_rows(RESULTS_MD)
     for r in table_rows(RESULTS_MD):
         if r["LUT4"].isdigit():

@@ -176,6 +176,13 @@ async def period_large_n(dut):
 STALL_IRQ = 9
 
 
+async def step_forward(env) -> None:
+    """One step forward, set at the next falling edge (sampled at the rising edge after it)."""
+    await FallingEdge(env.dut.clk)
+    env.pos += 1
+    env.dut.a_in.value, env.dut.b_in.value = QUAD[env.pos % 4]
+
+
 async def clocks_to_stall(env, t: int, pre: int) -> int:
     """STALL_TIMEOUT t at TB_PRESCALE pre (any stall of the settings over, events cleared): a step,
     and the clocks from it to irq."""
@@ -188,9 +195,7 @@ async def clocks_to_stall(env, t: int, pre: int) -> int:
     await bus.events()
     await env.settle(3)
     assert dut.irq.value == 0
-    await FallingEdge(dut.clk)
-    env.pos += 1
-    dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+    await step_forward(env)
     n = 0
     while dut.irq.value == 0:
         await RisingEdge(dut.clk)
@@ -252,24 +257,18 @@ async def stall_ended_by_a_step(dut):
     await env.setup(model, count=0, filter_len=1)
     p = engine_period(int(dut.CHANNELS.value)) if env.engine else 0
     stalled_lsb = regmap()["STATUS"].fields["STALLED"].lsb
-
-    async def step():
-        await FallingEdge(dut.clk)
-        env.pos += 1
-        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
-
     seen = {True: 0, False: 0}
     for t in (0x1F0, 0x2A5, 0x1005):
         await bus.wr("STALL_TIMEOUT", t)
         await env.applied()
         for trial in range(8):
             g = rng.choice((rng.randint(t - 40, t - 3), rng.randint(t + 3, t + 2 * p + 40)))
-            await step()
+            await step_forward(env)
             await env.settle()  # less than t: no stall; the events of the trial before read out
             await bus.events()
-            await step()
+            await step_forward(env)
             await ClockCycles(dut.clk, g - 1)
-            await step()
+            await step_forward(env)
             await env.settle()
             got = "STALL" in await bus.events()
             assert got == (g > t), f"STALL_TIMEOUT {t:#x}, the next step {g} clocks later: " \

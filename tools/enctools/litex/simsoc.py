@@ -233,10 +233,11 @@ def build_gateware(cfg: SocConfig, force: bool = False) -> float:
 
 
 def _prune(cfg: SocConfig) -> None:
-    """Delete what a built SoC no longer needs, about 0.55 of its 0.68 GB (0.13 GB stay): the simulator's object
-    files and precompiled headers (obj_dir/: Vsim stays) and picolibc's objects and intermediate
-    archives (the firmware links libc.a and includes picolibc.h). A rebuild (a new gateware key)
-    makes them again: meson keeps its configuration and compiles afresh."""
+    """Delete what a built SoC no longer needs, about 0.55 of its 0.68 GB (0.13 GB stay): the
+    simulator's object files, archives and precompiled headers in obj_dir/ (Vsim, the generated
+    C++ and the makefiles stay) and picolibc's objects and intermediate archives (the firmware
+    links libc.a and includes picolibc.h). A rebuild (a new gateware key) makes them again: meson
+    keeps its configuration and compiles afresh."""
     toolenv.prune_verilator_build(_gateware(cfg) / "obj_dir")
     libc = cfg.out / "software" / "libc"
     shutil.rmtree(libc / "newlib", ignore_errors=True)

@@ -203,21 +203,17 @@ def split_row(line: str) -> list[str]:
 
 
 def previous_rows(path: Path) -> dict[tuple[str, str, str], tuple[int, float | None]]:
-    """(module, params, part) -> (LUT4, Fmax) of each row of the results table on disk."""
+    """(module, params, part) -> (LUT4, Fmax) of each row of the results table on disk that has
+    figures (kept_rows' rows; Fmax None where the cell is not a plain number)."""
     out = {}
-    if not path.exists():
-        return out
-    for line in path.read_text().splitlines():
-        if line.startswith("Edge-capture FIFO"):
-            break  # the FIFO table: its rows are not results rows
-        cols = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cols) < 7 or not cols[3].isdigit():
+    for key, row in kept_rows(path).items():
+        if not row.get("LUT4", "").isdigit():
             continue
         try:
-            fmax = float(cols[6])
+            fmax = float(row.get("Fmax (MHz)", ""))
         except ValueError:
             fmax = None
-        out[(cols[0], cols[1], cols[2])] = (int(cols[3]), fmax)
+        out[key] = (int(row["LUT4"]), fmax)
     return out
 
 
