@@ -237,6 +237,38 @@ async def error_counters_saturate(dut):
     await bus.events()
 
 
+@cocotb_test()
+async def glitch_count_saturates(dut):
+    """GLITCH_COUNT's top bit and its saturation at 0xFFFF ("Number of clocks with a rejected A/B
+    level (GLITCH events), saturating at 0xFFFF"): with FILTER_LEN 2, 32,770 lone one-clock pulses on A or B (each one rejected
+    level, the count unchanged) read 32,770 (bit 15 set), 32,770 more read 0xFFFF, not the sum
+    modulo 2^16; QERR_COUNT stays 0; a write clears GLITCH_COUNT."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    n = 32770
+    await env.setup(model, func="x4", filter_len=2, count=0)
+    await bus.wr("GLITCH_COUNT", 0)
+    await env.applied()
+    before = await bus.count()
+    for want in (n, 0xFFFF):
+        # the present state for 2 clocks, a step for 1 clock (rejected), back: 3 clocks a pulse
+        wf = walk([1, -1] * n, [2 * T_NS, T_NS] * n, start_pos=env.pos)
+        await FallingEdge(dut.clk)  # (levels of whole clocks)
+        await env.drv.play(wf)
+        await env.settle(10)
+        got = await bus.rd("GLITCH_COUNT")
+        assert got == want, \
+            f"GLITCH_COUNT {got:#x} after {want if want == n else 2 * n} rejected pulses, not {want:#x}"
+    assert await bus.count() == before, "a rejected pulse moved COUNT"
+    assert await bus.rd("QERR_COUNT") == 0, "a rejected pulse counted as a quadrature error"
+    await bus.wr("GLITCH_COUNT", 0)
+    await env.applied()
+    await env.settle(10)
+    assert await bus.rd("GLITCH_COUNT") == 0, "GLITCH_COUNT not cleared by a write"
+    await bus.events()
+
+
 @cocotb_test(skip=lacks("RANGE"))
 async def cmp_on_load(dut):
     """A COUNT load that makes the count equal COMPARE raises CMP and pulses cmp_out once, for one
