@@ -242,6 +242,84 @@ def lane_parts() -> LaneParts | None:
                      rec_bits=sum(isinstance(b, int) for b in bits), rec_w=len(bits))
 
 
+# The floor of a lane: enc_qei_floor_bank (tools/enctools/synth/floor/), FLOOR_LANES lanes that
+# keep only what must see every clock (enc_qei_floor_lane's header lists it and what it leaves
+# out), read through the same one-hot AND-OR, flattened as the engine builds are. At each P of
+# FLOOR_P: the clocks between two reads of a lane (LANE_CHANNELS: one lane read a clock; the
+# engine's 24 clocks a visit).
+FLOOR_FILES = ("rtl/enc_filter_rt.v", "tools/enctools/synth/floor/enc_qei_floor_lane.v",
+               "tools/enctools/synth/floor/enc_qei_floor_bank.v")
+FLOOR_LANES = 16
+FLOOR_P = (FLOOR_LANES, 24 * FLOOR_LANES)
+
+
+@dataclass(frozen=True)
+class Floor:
+    p: int         # clocks between two reads of a lane
+    luts: int      # LUT4 of the bank of FLOOR_LANES lanes, flattened
+    lane: int      # LUT4 of one lane, its filters included (hierarchy kept)
+    filters: int   # of them, its input filters
+    rec_bits: int  # its record's bits
+
+
+def floor_lanes() -> list[Floor]:
+    """The floor bank's LUT4 at each P of FLOOR_P (HX8K); [] when Yosys fails."""
+    out = []
+    for p in FLOOR_P:
+        name = f"floor_p{p}"
+        (BUILD / name).mkdir(parents=True, exist_ok=True)
+        files = " ".join(rel(TOP / f, BUILD / name) for f in FLOOR_FILES)
+        head = f"read_verilog {files}\nchparam -set N {FLOOR_LANES} -set P {p} enc_qei_floor_bank\n"
+        flat = run_yosys(name, head + "synth_ice40 -top enc_qei_floor_bank\n"
+                                      "tee -q -o stat.json stat -json\n")
+        kept = run_yosys(name + "_h", head + "synth_ice40 -noflatten -top enc_qei_floor_bank\n"
+                                             "tee -q -o stat.json stat -json\nwrite_json net.json\n")
+        if flat is None or kept is None:
+            return []
+        luts = module_luts(kept["stat"])
+        lane = next((v for m, v in kept["net"]["modules"].items()
+                     if m.endswith("enc_qei_floor_lane")), None)
+        lane_cells = next((v.get("num_cells_by_type", {}) for m, v in kept["stat"]["modules"].items()
+                           if m.endswith("enc_qei_floor_lane")), {})
+        if lane is None or "enc_filter_rt" not in luts:
+            print("synth: the floor lane was not found in its netlist; the channel table goes "
+                  "without its floor")
+            return []
+        n_filters = next((n for t, n in lane_cells.items()
+                          if (module_of(kept["stat"]["modules"], t) or "").endswith("enc_filter_rt")), 0)
+        out.append(Floor(p=p, luts=flat["stat"]["design"]["num_cells_by_type"].get("SB_LUT4", 0),
+                         lane=luts["enc_qei_floor_lane"], filters=n_filters * luts["enc_filter_rt"],
+                         rec_bits=len(lane["ports"]["rec"]["bits"])))
+    return out
+
+
+def floor_markdown(floors: list[Floor], lane: LaneParts | None) -> list[str]:
+    """The floor's paragraph and table (nothing without floors)."""
+    if not floors:
+        return []
+    rows = [f"| {f.p} | {f.rec_bits} | {f.lane} | {f.filters} | {f.luts:,} | "
+            f"{f.luts / FLOOR_LANES:.0f} |" for f in floors]
+    ours = "" if lane is None else (
+        f" The engine's lean lane (`enc_qei_lane`, above), at the engine's P, also keeps what the "
+        f"floor lane's header lists as left out, and costs {lane.lane} LUT4 with its hierarchy "
+        "kept.")
+    return [
+        f"The floor of a lane: `enc_qei_floor_bank` ({FLOOR_LANES} lanes of "
+        "`tools/enctools/synth/floor/enc_qei_floor_lane.v`, not part of the IP) keeps in a lane only "
+        "what must see every clock: the three input filters with FILTER_LEN at run time, an x4 "
+        "decode, a free-running step accumulator, the ticks since the last step, the index latch "
+        "(EDGE, gate, ARM, ONESHOT) and the snapshot's capture of both, the error counts and STATUS; "
+        "it leaves the count's loads, exact OVERFLOW / UNDERFLOW, the other count functions and "
+        "every time stamp but `since` to an engine, and has no engine, no bus and no count. It is "
+        "read through the same one-hot AND-OR. P: the clocks between two reads of a lane (16: one "
+        f"lane read every clock; {24 * FLOOR_LANES}: the engine's 24 clocks a visit), which sets "
+        "its widths. Per lane: its LUT4 with the hierarchy kept (filters included, the OR of the "
+        f"lanes not), and the flattened bank's LUT4 over {FLOOR_LANES}." + ours, "",
+        f"| P | record bits | one lane, hierarchy kept | of it: filters | {FLOOR_LANES} lanes, "
+        "flattened | per lane |",
+        "|---:|---:|---:|---:|---:|---:|", *rows, ""]
+
+
 def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
     cost = readout_cost()
     readout = [] if cost is None else [
@@ -267,6 +345,7 @@ def channels_markdown(results: dict[str, Result], channels: list[int]) -> str:
             f"{cost:.2f} LUT4 per bit (the AND with the lane's read is in the lane, the OR of the "
             f"lanes in the engine) | "
             f"{round(lane.rec_bits * cost)} |", ""]
+    readout += floor_markdown(floor_lanes() if cost is not None else [], lane)
     parts = []
     for title, metric, _, _ in METRICS:
         table = channel_table(results, channels, metric)
