@@ -31,9 +31,9 @@
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy).
-// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET
-// and CEILING, for one channel f (any, fixed; the bus writes any of its registers but COUNT_HI):
-// see the section at the end.
+// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET,
+// CEILING and the snapshot's words, for one channel f (any, fixed; the bus writes any of its
+// registers but COUNT_HI): see the section at the end.
 `default_nettype none
 `ifdef ENGINE_DATA
 `include "enc_qei_lane_w.vh"
@@ -273,7 +273,7 @@ module enc_qei_engine_formal #(
   end
 
 `ifdef ENGINE_DATA
-  // ---- the data path of the count, its latches, PRESET and CEILING (tasks data, data_ch3) -----------
+  // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (tasks data, data_ch3)
   // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI),
   // with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's
   // read and the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with PRESET and
@@ -292,6 +292,14 @@ module enc_qei_engine_formal #(
   // bytes and, in those it leaves, COUNT_LO as read when it was written; a PRESET or CEILING write
   // (either half) carries its data and byte enables as written; no other write of f reaches
   // these words.
+  // The snapshot's other words, the same way: from the record of f's read (its motion, last edge
+  // and snapshot fields) with the timebase in the read's clock and the motion, last edge and last
+  // snapshot as stored at the visit (W_MOT, W_EDGE, W_SBASE), through rtl/enc_qei_lane.vh's
+  // lane_sdiff and lane_tstamp (formal/enc_qei_lane.sby proves them the motion and time of the
+  // capture's clock), the write-back writes W_MOT, W_EDGE and W_SBASE whole in slots 9, 10, 11,
+  // and SNAP_TIME / SNAP_EDGE_TIME (slot 13) and SNAP_DELTA / SNAP_EDGE_DELTA (slot 14) when the
+  // snapshot is pending (or f's first write-back); the memory keeps them; a bus read of the four
+  // registers answers its half of the word as stored.
   localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
   localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
   localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
@@ -303,15 +311,26 @@ module enc_qei_engine_formal #(
   localparam [4:0]  W_CNT = 5'd0, W_PRESET = 5'd4, W_CEIL = 5'd5, W_SCNT = 5'd13, W_ILATCH = 5'd16,
                     W_PLATCH = 5'd17;
   localparam [4:0]  S_SCNT = 5'd12, S_ILATCH = 5'd15, S_PLATCH = 5'd16;  // their write slots
-  localparam integer NPEEK = 6;  // enc_qei_ram's F_PEEK
+  // the snapshot's words and the words they are made from: the motion (W_MOT), the last edge
+  // (W_EDGE), the motion and edge at the last snapshot (W_SBASE), SNAP_TIME / SNAP_EDGE_TIME
+  // (W_STIME), SNAP_DELTA / SNAP_EDGE_DELTA (W_SDELTA), and their write slots
+  localparam [4:0]  W_MOT = 5'd9, W_EDGE = 5'd11, W_SBASE = 5'd12, W_STIME = 5'd14,
+                    W_SDELTA = 5'd15;
+  localparam [4:0]  S_MOT = 5'd9, S_EDGE = 5'd10, S_SBASE = 5'd11, S_STIME = 5'd13, S_SDELTA = 5'd14;
+  localparam [31:0] SZ_T = (TS_W >= 32) ? 32'hFFFFFFFF : ((32'd1 << TS_W) - 32'd1);
+  localparam integer NPEEK = 11;  // enc_qei_ram's F_PEEK
   localparam [5:0]  OFF_CNT = ENC_QEI_COUNT_LO[7:2], OFF_SCNT = ENC_QEI_SNAP_COUNT_LO[7:2],
                     OFF_ILAT = ENC_QEI_INDEX_LATCH_LO[7:2], OFF_PLAT = ENC_QEI_PROBE_LATCH_LO[7:2],
                     OFF_PRE = ENC_QEI_PRESET_LO[7:2], OFF_PRE_HI = ENC_QEI_PRESET_HI[7:2],
-                    OFF_CEIL = ENC_QEI_CEILING_LO[7:2], OFF_CEIL_HI = ENC_QEI_CEILING_HI[7:2];
+                    OFF_CEIL = ENC_QEI_CEILING_LO[7:2], OFF_CEIL_HI = ENC_QEI_CEILING_HI[7:2],
+                    OFF_STIM = ENC_QEI_SNAP_TIME[7:2], OFF_SETIM = ENC_QEI_SNAP_EDGE_TIME[7:2],
+                    OFF_SDEL = ENC_QEI_SNAP_DELTA[7:2], OFF_SEDEL = ENC_QEI_SNAP_EDGE_DELTA[7:2];
 
   (* anyconst *) reg [3:0] f_ch;
   wire [AW-1:0] a_cnt = {f_ch, W_CNT}, a_pre = {f_ch, W_PRESET}, a_ceil = {f_ch, W_CEIL};
   wire [AW-1:0] a_scnt = {f_ch, W_SCNT}, a_ilat = {f_ch, W_ILATCH}, a_plat = {f_ch, W_PLATCH};
+  wire [AW-1:0] a_mot = {f_ch, W_MOT}, a_edge = {f_ch, W_EDGE}, a_sbase = {f_ch, W_SBASE};
+  wire [AW-1:0] a_stim = {f_ch, W_STIME}, a_sdel = {f_ch, W_SDELTA};
 
   (* keep *) wire [REC_W-1:0]    p_rec_or;   // eng.rec_or: the record of the lane read now
   (* keep *) wire [REC_W-1:0]    p_rec_q;    // eng.rec_q: c(v)'s
@@ -345,10 +364,22 @@ module enc_qei_engine_formal #(
   (* keep *) wire [31:0]         p_b_wdata;  // eng.b_wdata_q: the bus request's data
   (* keep *) wire [3:0]          p_b_wstrb;  // eng.b_wstrb_q: ... its byte enables
   (* keep *) wire [31:0]         p_b_cnt;    // eng.b_cnt_q: COUNT_LO as read for a write
-  (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
+  (* keep *) wire [63:0]         p_o_mot;    // eng.o_mot
+  (* keep *) wire [63:0]         p_o_edge;   // eng.o_edge
+  (* keep *) wire [63:0]         p_o_sbase;  // eng.o_sbase
+  (* keep *) wire [63:0]         p_n_mot;    // eng.n_mot_q
+  (* keep *) wire [63:0]         p_n_edge;   // eng.n_edge_q
+  (* keep *) wire [63:0]         p_n_sbase;  // eng.n_sbase_q
+  (* keep *) wire [63:0]         p_n_stime;  // eng.n_stime_q
+  (* keep *) wire [63:0]         p_n_sdel;   // eng.n_sdelta_q
+  (* keep *) wire [TS_W-1:0]     p_tv;       // eng.tv_q: the timebase at the read of c(v)
+  (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_sdel, a_stim, a_sbase, a_edge, a_mot, a_plat,
+                                                a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
   (* keep *) wire [NPEEK*4-1:0]  f_slot_addr = {NPEEK{f_ch}};  // -> eng.u_pend.f_peek_addr
   wire [63:0] m_cnt  = p_peek[0 +: 64],   m_pre  = p_peek[64 +: 64],  m_ceil = p_peek[128 +: 64];
   wire [63:0] m_scnt = p_peek[192 +: 64], m_ilat = p_peek[256 +: 64], m_plat = p_peek[320 +: 64];
+  wire [63:0] m_mot  = p_peek[384 +: 64], m_edge = p_peek[448 +: 64], m_sbase = p_peek[512 +: 64];
+  wire [63:0] m_stim = p_peek[576 +: 64], m_sdel = p_peek[640 +: 64];
 
   // the reference: the record of f's last read (rst: channel 0's first visit takes the reset
   // record, 0); the count stored (f_sto) and the one stored before it (f_base: the count at the
@@ -369,12 +400,43 @@ module enc_qei_engine_formal #(
   reg  [63:0]      f_pre, f_ceil;    // PRESET and CEILING as stored (f's write-back writes them)
   reg  [63:0]      f_vpre, f_vceil;  // ... at f's visit (the rebuild's)
   reg  [63:0]      f_pre_d, f_ceil_d;
+  // the snapshot's words: the record of f's last read (its motion, last edge and snapshot
+  // fields, error counts) and the timebase in its clock; the words as stored (f_mot .. f_sdel),
+  // and W_MOT, W_EDGE, W_SBASE at f's visit (the rebuild's: f_vmot, f_vedge, f_vsbase)
+  reg  [MOT_W-1:0] f_mpos, f_emp, f_smpos, f_semp;
+  reg  [TIM_W-1:0] f_et, f_stime, f_set;
+  reg  [ERR_W-1:0] f_qcnt, f_gcnt;
+  reg              f_xenew, f_xsnew, f_xsedge;  // R_ENEW, R_SNEW, R_SEDGE
+  reg  [31:0]      f_tv;
+  reg  [63:0]      f_mot, f_edge, f_sbase, f_stim, f_sdel;
+  reg  [63:0]      f_mot_d, f_edge_d, f_sbase_d, f_stim_d, f_sdel_d;
+  reg  [63:0]      f_vmot, f_vedge, f_vsbase;
   wire             f_ld_ok = f_lk && f_lx[41:36] == OFF_CNT;  // a COUNT_LO write was loaded
   wire [63:0]      f_ldb   = f_ld_ok ? {32'd0, f_lx[31:0]} & SZ : f_vpre;  // A_LOAD's value
   wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, f_ldb, f_vceil, f_base, SZ);
   wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
   wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
   wire [63:0]      f_pnew  = f_ppend ? lane_rebuild(f_pcap, f_panc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
+  // what the visit makes of them, with the rebuild functions of rtl/enc_qei_lane.vh (whose
+  // meaning formal/enc_qei_lane.sby proves: lane_sdiff the motion since the last read,
+  // lane_tstamp the time of a capture): the motion M adds the window's; the last edge's time
+  // and motion TE / ME when the window has one; at a snapshot SNAP_TIME, SNAP_EDGE_TIME (the
+  // snapshot's clock if it was an edge, the window's last edge before it, or the edge before the
+  // window), the motion MS and ME then, SNAP_DELTA and SNAP_EDGE_DELTA from the last snapshot's
+  wire [MOT_W-1:0] g_mb   = f_vmot[32 +: MOT_W];  // the lane's mpos at the read before
+  wire [31:0]      g_m0   = f_vmot[31:0];         // M then
+  wire [63:0]      g_dm   = lane_sdiff(f_mpos, g_mb), g_de = lane_sdiff(f_emp, g_mb);
+  wire [63:0]      g_dsm  = lane_sdiff(f_smpos, g_mb), g_dse = lane_sdiff(f_semp, g_mb);
+  wire [31:0]      g_mr   = g_m0 + g_dm[31:0];
+  wire [31:0]      g_ms   = g_m0 + g_dsm[31:0];
+  wire [31:0]      g_ts   = lane_tstamp(f_stime, f_tv) & SZ_T;
+  wire [31:0]      g_te_s = f_xsedge ? g_ts : f_xsnew ? lane_tstamp(f_set, f_tv) & SZ_T : f_vedge[31:0];
+  wire [31:0]      g_me_s = f_xsedge ? g_ms : f_xsnew ? g_m0 + g_dse[31:0] : f_vedge[63:32];
+  wire [63:0]      f_mot_new = {{(32 - MOT_W - 2 * ERR_W){1'b0}}, f_gcnt, f_qcnt, f_mpos, g_mr};
+  wire [63:0]      f_edge_new = f_xenew ? {g_m0 + g_de[31:0], lane_tstamp(f_et, f_tv) & SZ_T} : f_vedge;
+  wire [63:0]      f_sbase_new = f_spend ? {g_me_s, g_ms} : f_vsbase;
+  wire [63:0]      f_stim_new = f_spend ? {g_te_s, g_ts} : 64'd0;
+  wire [63:0]      f_sdel_new = f_spend ? {g_me_s - f_vsbase[63:32], g_ms - f_vsbase[31:0]} : 64'd0;
   wire             f_fresh = |(p_fresh & (1 << f_ch));
   wire             f_wbv   = p_wr_on && p_cw == f_ch;                    // f's write-back visit
   wire             f_wb    = f_wbv && p_slot == 5'd0;                    // ... its count's slot
@@ -382,10 +444,15 @@ module enc_qei_engine_formal #(
   wire             f_calc  = p_slot == V - 1 && p_cp == f_ch;            // f's visit computes
   wire             f_bus   = p_b_take && !p_b_wr && p_b_ch == f_ch;
   wire             f_watched = p_b_word == OFF_CNT || p_b_word == OFF_SCNT || p_b_word == OFF_ILAT ||
-                               p_b_word == OFF_PLAT || p_b_word == OFF_PRE || p_b_word == OFF_CEIL;
+                               p_b_word == OFF_PLAT || p_b_word == OFF_PRE || p_b_word == OFF_CEIL ||
+                               p_b_word == OFF_STIM || p_b_word == OFF_SETIM ||
+                               p_b_word == OFF_SDEL || p_b_word == OFF_SEDEL;
   wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
                               (p_b_word == OFF_ILAT) ? f_ilat_d : (p_b_word == OFF_PLAT) ? f_plat_d :
-                              (p_b_word == OFF_PRE) ? f_pre_d : f_ceil_d;
+                              (p_b_word == OFF_PRE) ? f_pre_d : (p_b_word == OFF_CEIL) ? f_ceil_d :
+                              (p_b_word == OFF_STIM) ? f_stim_d :
+                              (p_b_word == OFF_SETIM) ? {32'd0, f_stim_d[63:32]} :
+                              (p_b_word == OFF_SDEL) ? f_sdel_d : {32'd0, f_sdel_d[63:32]};
   wire [31:0]      f_word_rst = (p_b_word == OFF_PRE) ? PRE_RST[31:0] :
                                 (p_b_word == OFF_CEIL) ? CEIL_RST[31:0] : 32'd0;
 
@@ -451,6 +518,11 @@ module enc_qei_engine_formal #(
     f_plat_d <= f_plat;
     f_pre_d  <= f_pre;
     f_ceil_d <= f_ceil;
+    f_mot_d   <= f_mot;
+    f_edge_d  <= f_edge;
+    f_sbase_d <= f_sbase;
+    f_stim_d  <= f_stim;
+    f_sdel_d  <= f_sdel;
     if (rst) begin
       {f_lo, f_anc, f_spend, f_scap, f_sanc, f_ipend, f_icap, f_ianc, f_ppend, f_pcap, f_panc} <= 0;
       f_sto  <= 64'd0;
@@ -463,6 +535,14 @@ module enc_qei_engine_formal #(
       f_pk   <= 1'b0;
       f_pre  <= PRE_RST;
       f_ceil <= CEIL_RST;
+      {f_mpos, f_emp, f_smpos, f_semp, f_et, f_stime, f_set, f_qcnt, f_gcnt} <= 0;
+      {f_xenew, f_xsnew, f_xsedge} <= 3'd0;
+      f_tv    <= 32'd0;
+      f_mot   <= 64'd0;
+      f_edge  <= 64'd0;
+      f_sbase <= 64'd0;
+      f_stim  <= 64'd0;
+      f_sdel  <= 64'd0;
     end else begin
       if (f_rd_now) begin
         f_lk    <= p_n_taken && f_pk;
@@ -478,11 +558,27 @@ module enc_qei_engine_formal #(
         f_ppend <= p_rec_or[R_PPEND];
         f_pcap  <= p_rec_or[R_PLO +: R_PLO_W];
         f_panc  <= p_rec_or[R_PANC +: R_PANC_W];
+        f_mpos  <= p_rec_or[R_MPOS +: R_MPOS_W];
+        f_qcnt  <= p_rec_or[R_QCNT +: R_QCNT_W];
+        f_gcnt  <= p_rec_or[R_GCNT +: R_GCNT_W];
+        f_et    <= p_rec_or[R_ET +: R_ET_W];
+        f_emp   <= p_rec_or[R_EMP +: R_EMP_W];
+        f_xenew <= p_rec_or[R_ENEW];
+        f_smpos <= p_rec_or[R_SMPOS +: R_SMPOS_W];
+        f_stime <= p_rec_or[R_STIME +: R_STIME_W];
+        f_set   <= p_rec_or[R_SET +: R_SET_W];
+        f_semp  <= p_rec_or[R_SEMP +: R_SEMP_W];
+        f_xsnew <= p_rec_or[R_SNEW];
+        f_xsedge <= p_rec_or[R_SEDGE];
+        f_tv    <= {{(32 - TS_W){1'b0}}, timebase};
       end
       if (f_calc) begin
-        f_base  <= f_sto;
-        f_vpre  <= f_pre;
-        f_vceil <= f_ceil;
+        f_base   <= f_sto;
+        f_vpre   <= f_pre;
+        f_vceil  <= f_ceil;
+        f_vmot   <= f_mot;
+        f_vedge  <= f_edge;
+        f_vsbase <= f_sbase;
       end
       // PRESET and CEILING: f's write-back writes the write its visit took (slots 4, 5)
       if (f_wbv && p_slot == 5'd4 && f_lk) f_pre <= wide_merge(f_pre, f_lx, OFF_PRE);
@@ -491,6 +587,11 @@ module enc_qei_engine_formal #(
       if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
       if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
       if (f_wbv && p_slot == S_PLATCH && (f_ppend || f_fresh)) f_plat <= f_pnew;
+      if (f_wbv && p_slot == S_MOT) f_mot <= f_mot_new;
+      if (f_wbv && p_slot == S_EDGE) f_edge <= f_edge_new;
+      if (f_wbv && p_slot == S_SBASE) f_sbase <= f_sbase_new;
+      if (f_wbv && p_slot == S_STIME && (f_spend || f_fresh)) f_stim <= f_stim_new;
+      if (f_wbv && p_slot == S_SDELTA && (f_spend || f_fresh)) f_sdel <= f_sdel_new;
       if (p_b_take && p_b_wr && p_b_ch == f_ch) f_bcnt <= f_fresh ? 32'd0 : f_sto_d[31:0];
       if (p_b_st == B_POST && p_b_ch == f_ch) begin
         f_pk <= watched_w({p_b_word, p_b_wstrb, p_b_wdata});
@@ -565,6 +666,12 @@ module enc_qei_engine_formal #(
       stored_word(a_scnt, S_SCNT, f_spend, f_snew, m_scnt, f_scnt, p_n_scnt, p_n_snap);
       stored_word(a_ilat, S_ILATCH, f_ipend, f_inew, m_ilat, f_ilat, p_n_ilat, p_n_latch);
       stored_word(a_plat, S_PLATCH, f_ppend, f_pnew, m_plat, f_plat, p_n_plat, p_n_probe);
+      // the snapshot's words and those they are made from
+      stored_word(a_mot, S_MOT, 1'b1, f_mot_new, m_mot, f_mot, p_n_mot, 1'b1);
+      stored_word(a_edge, S_EDGE, 1'b1, f_edge_new, m_edge, f_edge, p_n_edge, 1'b1);
+      stored_word(a_sbase, S_SBASE, 1'b1, f_sbase_new, m_sbase, f_sbase, p_n_sbase, 1'b1);
+      stored_word(a_stim, S_STIME, f_spend, f_stim_new, m_stim, f_stim, p_n_stime, p_n_snap);
+      stored_word(a_sdel, S_SDELTA, f_spend, f_sdel_new, m_sdel, f_sdel, p_n_sdel, p_n_snap);
       // (f is fresh until the end of slot 19 of its first write-back; the first visit writes nothing)
       if (f_wbv && p_slot >= 5'd20) assert (!f_fresh);
       if (!p_wr_on) assert (p_cp == 4'd0 && f_fresh && f_sto == 64'd0);
@@ -578,6 +685,9 @@ module enc_qei_engine_formal #(
         if (|p_ip_pre || |p_ip_ceil)
           assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
         if (p_slot == 5'd0) assert (f_base == f_sto);
+        if (p_slot <= S_MOT) assert (f_vmot == f_mot);
+        if (p_slot <= S_EDGE) assert (f_vedge == f_edge);
+        if (p_slot <= S_SBASE) assert (f_vsbase == f_sbase);
         // PRESET and CEILING as the visit had them, then with its write
         assert (f_pre == ((p_slot >= 5'd5 && f_lk) ? wide_merge(f_vpre, f_lx, OFF_PRE) : f_vpre));
         assert (f_ceil == ((p_slot >= 5'd6 && f_lk) ? wide_merge(f_vceil, f_lx, OFF_CEIL) : f_vceil));
@@ -591,12 +701,24 @@ module enc_qei_engine_formal #(
                 p_rec_q[R_LANC +: R_LANC_W] == f_ianc);
         assert (p_rec_q[R_PPEND] == f_ppend && p_rec_q[R_PLO +: R_PLO_W] == f_pcap &&
                 p_rec_q[R_PANC +: R_PANC_W] == f_panc);
+        assert (p_rec_q[R_MPOS +: R_MPOS_W] == f_mpos && p_rec_q[R_QCNT +: R_QCNT_W] == f_qcnt &&
+                p_rec_q[R_GCNT +: R_GCNT_W] == f_gcnt);
+        assert (p_rec_q[R_ET +: R_ET_W] == f_et && p_rec_q[R_EMP +: R_EMP_W] == f_emp &&
+                p_rec_q[R_ENEW] == f_xenew);
+        assert (p_rec_q[R_SMPOS +: R_SMPOS_W] == f_smpos && p_rec_q[R_STIME +: R_STIME_W] == f_stime &&
+                p_rec_q[R_SET +: R_SET_W] == f_set && p_rec_q[R_SEMP +: R_SEMP_W] == f_semp &&
+                p_rec_q[R_SNEW] == f_xsnew && p_rec_q[R_SEDGE] == f_xsedge);
+        assert ({{(32 - TS_W){1'b0}}, p_tv} == f_tv);
         if (p_slot >= 5'd12) assert (p_o_cnt == f_sto);
+        if (p_slot >= 5'd13) assert (p_o_mot == f_mot);
+        if (p_slot >= 5'd15) assert (p_o_edge == f_edge);
+        if (p_slot >= 5'd16) assert (p_o_sbase == f_sbase);
         if (p_slot >= 5'd19) assert (p_o_pre == f_pre);
         if (p_slot >= 5'd20) assert (p_o_ceil == f_ceil);
       end
-      // the bus: a read of f's COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO, PROBE_LATCH_LO, PRESET_LO
-      // or CEILING_LO answers the word as stored in the clock of its port-b read
+      // the bus: a read of f's COUNT_LO, SNAP_COUNT_LO, INDEX_LATCH_LO, PROBE_LATCH_LO, PRESET_LO,
+      // CEILING_LO, SNAP_TIME, SNAP_EDGE_TIME, SNAP_DELTA or SNAP_EDGE_DELTA answers the word (its
+      // half) as stored in the clock of its port-b read
       if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
                          p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
       if (f_chk && resp_valid) assert (resp_rdata == f_exp);
