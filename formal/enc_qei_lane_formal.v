@@ -21,7 +21,11 @@
 // (step_up / step_dn, qerr) and filters (glitch_q), and its own timebase: M equals the steps
 // counted (each +1 / -1), the error and glitch counts equal the errors and rejected levels
 // counted; a snapshot waiting at the read has the timebase and the motion of its clock, a probe
-// latch the timebase of its clock; a global snapshot (gsnap) is taken in its clock. With three
+// latch the timebase of its clock; a global snapshot (gsnap) is taken in its clock; the last
+// selected edge (the lane's sel_q) as the engine keeps it from the records (W_EDGE) is the last
+// one, with its timebase and motion, at every read, and a waiting snapshot's edge as the engine
+// makes it (te_s, me_s: its own clock's, the window's last before it, or the one kept) is the
+// last selected edge at or before its clock. With three
 // bits less of MOT_W or two of ERR_W (the wrapper's MOT_CUT / ERR_CUT, deliberate breaks) it
 // fails; with two and one it passes (MOT_W is sized for the reach of lo, not for the motion).
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
@@ -153,24 +157,56 @@ module enc_qei_lane_formal #(
   (* keep *) wire [MOT_W-1:0] p_smpos;   // lane.g_snap.smpos_q
   (* keep *) wire [TIM_W-1:0] p_stime;   // lane.g_snap.stime_q
   (* keep *) wire [TIM_W-1:0] p_ptime;   // lane.g_probe.ptime_q
+  (* keep *) wire             p_sel;     // lane.g_snap.sel_q: a selected edge (SNAP_CTRL.EDGE),
+                                         // its step in mpos from this clock
+  (* keep *) wire [TIM_W-1:0] p_et;      // lane.g_snap.et_q: the last selected edge's time
+  (* keep *) wire [MOT_W-1:0] p_emp;     // lane.g_snap.emp_q: ... and mpos with it
+  (* keep *) wire             p_enew;    // lane.g_snap.enew_q: one in this window
+  (* keep *) wire [TIM_W-1:0] p_set;     // lane.g_snap.set_q: at the snapshot, the last edge's time
+  (* keep *) wire [MOT_W-1:0] p_semp;    // lane.g_snap.semp_q: ... its mpos
+  (* keep *) wire             p_snew;    // lane.g_snap.snew_q: ... in the snapshot's window
+  (* keep *) wire             p_sedge;   // lane.g_snap.sedge_q: an edge in the snapshot's clock
 
   // ---- the wrapper's wide counts (as the lane's registers take them) ------------------------------
   reg [WW-1:0] f_m, f_q, f_g;       // steps (+1 / -1), errors, rejected levels
   reg [WW-1:0] f_sm, f_st, f_pt;    // a snapshot's motion and timebase, a probe latch's timebase
+  // the last selected edge: its timebase and the motion with its step (0, 0 after rst), and
+  // whether one came since the last read (a selected edge in a read's clock is the next
+  // window's); at a snapshot: that edge as it was before the snapshot's clock, whether it was in
+  // the snapshot's window, whether the snapshot's own clock had one, and the last edge at or
+  // before the snapshot's clock (what SNAP_EDGE_TIME and the motion SNAP_EDGE_DELTA counts to mean)
+  reg [WW-1:0] f_et, f_em;
+  reg          f_en;
+  reg [WW-1:0] f_sset, f_sem, f_sxt, f_sxm;
+  reg          f_snw, f_sed;
 
   always @(posedge clk) begin
     if (rst) begin
-      f_m <= {WW{1'b0}};
-      f_q <= {WW{1'b0}};
-      f_g <= {WW{1'b0}};
+      f_m  <= {WW{1'b0}};
+      f_q  <= {WW{1'b0}};
+      f_g  <= {WW{1'b0}};
+      f_et <= {WW{1'b0}};
+      f_em <= {WW{1'b0}};
+      f_en <= 1'b0;
     end else begin
-      f_m <= f_m + (p_dn ? {WW{1'b1}} : {{(WW-1){1'b0}}, p_up});
-      f_q <= f_q + {{(WW-1){1'b0}}, p_qerr};
-      f_g <= f_g + {{(WW-1){1'b0}}, p_glitch};
+      f_m  <= f_m + (p_dn ? {WW{1'b1}} : {{(WW-1){1'b0}}, p_up});
+      f_q  <= f_q + {{(WW-1){1'b0}}, p_qerr};
+      f_g  <= f_g + {{(WW-1){1'b0}}, p_glitch};
+      if (p_sel) begin
+        f_et <= f_tb;
+        f_em <= f_m;
+      end
+      f_en <= p_sel | (f_en & ~rd);
     end
     if (p_take) begin
-      f_sm <= f_m;
-      f_st <= f_tb;
+      f_sm   <= f_m;
+      f_st   <= f_tb;
+      f_sset <= f_et;
+      f_sem  <= f_em;
+      f_snw  <= f_en & ~rd;
+      f_sed  <= p_sel;
+      f_sxt  <= p_sel ? f_tb : f_et;
+      f_sxm  <= p_sel ? f_m : f_em;
     end
     if (p_phit) f_pt <= f_tb;
   end
@@ -204,6 +240,10 @@ module enc_qei_lane_formal #(
   wire [ERR_W-1:0] x_gcnt  = rec[R_GCNT +: R_GCNT_W];
   wire [TIM_W-1:0] x_stime = rec[R_STIME +: R_STIME_W];
   wire [TIM_W-1:0] x_ptime = rec[R_PTIME +: R_PTIME_W];
+  wire [TIM_W-1:0] x_et    = rec[R_ET +: R_ET_W];
+  wire [MOT_W-1:0] x_emp   = rec[R_EMP +: R_EMP_W];
+  wire [TIM_W-1:0] x_set   = rec[R_SET +: R_SET_W];
+  wire [MOT_W-1:0] x_semp  = rec[R_SEMP +: R_SEMP_W];
 
   reg  [WW-1:0]    e_m, e_q, e_g;  // M, the error and glitch counts, as of the last read
   reg  [MOT_W-1:0] e_mb;           // mpos at the last read
@@ -211,6 +251,17 @@ module enc_qei_lane_formal #(
   wire [WW-1:0]    e_m_n = e_m + sdiff(x_mpos, e_mb);
   wire [WW-1:0]    e_q_n = e_q + {{(WW - ERR_W){1'b0}}, x_qcnt - e_qb};
   wire [WW-1:0]    e_g_n = e_g + {{(WW - ERR_W){1'b0}}, x_gcnt - e_gb};
+  // the last selected edge as the engine keeps it (W_EDGE: TE, ME), from the records: the
+  // window's when it has one (R_ENEW), else the one kept; at a snapshot the engine's SNAP_EDGE
+  // time and motion: the snapshot's own when its clock had one (R_SEDGE), the window's last
+  // before it (R_SNEW), else the one kept (enc_qei_engine's te_s, me_s)
+  reg  [WW-1:0]    e_et, e_em;
+  wire [WW-1:0]    e_et_n = rec[R_ENEW] ? tstamp(x_et, f_tb) : e_et;
+  wire [WW-1:0]    e_em_n = rec[R_ENEW] ? e_m + sdiff(x_emp, e_mb) : e_em;
+  wire [WW-1:0]    e_st   = tstamp(x_stime, f_tb);
+  wire [WW-1:0]    e_sm   = e_m + sdiff(x_smpos, e_mb);
+  wire [WW-1:0]    e_sxt  = rec[R_SEDGE] ? e_st : rec[R_SNEW] ? tstamp(x_set, f_tb) : e_et;
+  wire [WW-1:0]    e_sxm  = rec[R_SEDGE] ? e_sm : rec[R_SNEW] ? e_m + sdiff(x_semp, e_mb) : e_em;
 
   always @(posedge clk) begin
     if (rst) begin
@@ -220,7 +271,11 @@ module enc_qei_lane_formal #(
       e_mb <= {MOT_W{1'b0}};
       e_qb <= {ERR_W{1'b0}};
       e_gb <= {ERR_W{1'b0}};
+      e_et <= {WW{1'b0}};
+      e_em <= {WW{1'b0}};
     end else if (rd) begin
+      e_et <= e_et_n;
+      e_em <= e_em_n;
       e_m  <= e_m_n;
       e_q  <= e_q_n;
       e_g  <= e_g_n;
@@ -245,6 +300,8 @@ module enc_qei_lane_formal #(
   wire [WW-1:0] el_w   = {6'd0, el_q};
   wire [WW-1:0] age_st = f_tb - f_st;  // ticks since the snapshot
   wire [WW-1:0] age_pt = f_tb - f_pt;  // ... since the probe latch
+  wire [WW-1:0] age_et = f_tb - f_et;  // ... since the last selected edge
+  wire [WW-1:0] age_ss = f_tb - f_sset; // ... since the last one before the snapshot
 
   always @(*) begin
     if (f_past && !rst) begin
@@ -262,6 +319,20 @@ module enc_qei_lane_formal #(
       if (p_spend) assert (wdist(f_m, f_sm) <= el_w && wdist(f_sm, e_m) <= el_w && age_st <= el_w &&
                            p_smpos == f_sm[MOT_W-1:0] && p_stime == f_st[TIM_W-1:0]);
       if (p_ppend) assert (age_pt <= el_w && p_ptime == f_pt[TIM_W-1:0]);
+      // the last selected edge: the lane's low bits of it; one in this window is at most el_q
+      // clocks old; without one the engine's kept edge is it
+      assert (p_et == f_et[TIM_W-1:0] && p_emp == f_em[MOT_W-1:0] && p_enew == f_en);
+      if (f_en) assert (age_et <= el_w && wdist(f_em, e_m) <= el_w);
+      else assert (e_et == f_et && e_em == f_em);
+      // a capture waiting: the last edge as before its clock, in its window or kept by the
+      // engine; the edge at or before its clock
+      if (p_spend) begin
+        assert (p_set == f_sset[TIM_W-1:0] && p_semp == f_sem[MOT_W-1:0] && p_snew == f_snw &&
+                p_sedge == f_sed);
+        assert (f_sxt == (f_sed ? f_st : f_sset) && f_sxm == (f_sed ? f_sm : f_sem));
+        if (f_snw) assert (age_ss <= el_w && wdist(f_sem, e_m) <= el_w);
+        else if (!f_sed) assert (e_et == f_sset && e_em == f_sem);
+      end
       if (rd) begin
         // the motion, the error and glitch counts: not a step lost
         assert (e_m_n == f_m);
@@ -270,6 +341,10 @@ module enc_qei_lane_formal #(
         // a snapshot: its timebase and its motion; a probe latch: its timebase
         if (rec[R_SPEND]) assert (tstamp(x_stime, f_tb) == f_st && e_m + sdiff(x_smpos, e_mb) == f_sm);
         if (rec[R_PPEND]) assert (tstamp(x_ptime, f_tb) == f_pt);
+        // the last selected edge: its timebase and motion; a snapshot's last edge at or before
+        // its clock (SNAP_EDGE_TIME, the motion SNAP_EDGE_DELTA counts to)
+        assert (e_et_n == f_et && e_em_n == f_em);
+        if (rec[R_SPEND]) assert (e_sxt == f_sxt && e_sxm == f_sxm);
       end
     end
   end
