@@ -30,7 +30,9 @@
 //     applied (busy), never both; the bus posts a write only into a free slot of a channel with no
 //     write unapplied; the engine takes only a waiting write and completes only a taken one; a
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
-//     minus completed writes is pend | busy).
+//     minus completed writes is pend | busy);
+//   - a write acts within the RDL's bounds (CAPS.ENGINE shared, (2)): P + 14 clocks after its
+//     answer, P + 18 after its request (a state write: P + 22, P + 26): see that section.
 // With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET,
 // CEILING and the snapshot's words, for one channel f (any, fixed; the bus writes any of its
 // registers but COUNT_HI): see the section at the end.
@@ -66,6 +68,7 @@ module enc_qei_engine_formal #(
   localparam integer V      = 24;
   localparam integer P      = V * CH_EFF;
   localparam integer AW     = 9;  // the state memory's address bits (enc_qei_engine: CH_W + 5)
+  `include "enc_qei_regs.vh"
 
   wire                resp_valid, gsnap;
   wire [31:0]         resp_rdata;
@@ -126,6 +129,8 @@ module enc_qei_engine_formal #(
   (* keep *) wire [2:0]          p_b_st;      // eng.b_st_q
   (* keep *) wire [3:0]          p_b_ch;      // eng.b_ch_q: the request's channel
   (* keep *) wire                p_b_take;    // eng.b_take: the bus takes port b's data now
+  (* keep *) wire                p_b_wr;      // eng.b_wr_q: the request is a write
+  (* keep *) wire [5:0]          p_b_word;    // eng.b_word_q: ... of this register
   (* keep *) wire [CHANNELS-1:0] p_pend;      // eng.pend_q
   (* keep *) wire [CHANNELS-1:0] p_busy;      // eng.busy_q
   (* keep *) wire [CHANNELS-1:0] p_pend_st;   // eng.pend_st_q
@@ -272,6 +277,123 @@ module enc_qei_engine_formal #(
     end
   end
 
+  // ---- when a write acts (CAPS.ENGINE shared, (2)): the bounds of the RDL, in clocks -------------
+  // A write of channel k is posted by the bus in the clock before its answer (pend_set) and acts:
+  // a write of a register the counting uses at the lane's read after the engine takes it (a
+  // COUNT_LO write in the clock before that read, where it loads the count); a state write
+  // (EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN) when its word is written back (done). The RDL's
+  // words: at most P + 14 (state: P + 22) clocks after the answer, and P + 18 (P + 26) after the
+  // request when it did not wait for an earlier write of the channel (its B_WAIT one clock).
+  // The wrapper counts the clocks from the answer (f_wage) and keeps the answer's delay after
+  // the request (f_wrq, 7: more) and whether it waited; its invariants place the write in the
+  // schedule (where its take and act come).
+  localparam [5:0] OFF_CNT_LO = ENC_QEI_COUNT_LO[7:2];
+  reg  [7:0]          f_wage [0:CHANNELS-1];
+  reg  [2:0]          f_wrq  [0:CHANNELS-1];
+  reg  [CHANNELS-1:0] f_wlive;    // a posted write that has not acted yet
+  reg  [CHANNELS-1:0] f_wcnt;     // ... a COUNT_LO write
+  reg  [CHANNELS-1:0] f_nowait;   // ... that did not wait
+  reg  [2:0]          f_rq_age;   // clocks since the bus's request, less 1 (7: more)
+  reg  [1:0]          f_wc;       // ... its clocks in B_WAIT so far (2: more than one)
+  reg  [CHANNELS-1:0] f_act;      // the write acts in this clock (combinational)
+
+  // clocks from now to the next clock with slot s and channel field (c(v + 1) or c(v)) k
+  function [7:0] until;
+    input [3:0] k;
+    input [4:0] s;
+    input [3:0] cur;
+    input [4:0] slot;
+    begin
+      if (cur == k && slot <= s) until = {3'd0, s - slot};
+      else until = V * ((cur == k) ? CH_EFF : dist(k, cur)) + s - slot;
+    end
+  endfunction
+
+  always @(*) begin
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      f_act[k] = f_wlive[k] && (p_pend_st[k] ? p_done[k] :
+                                p_busy[k] && p_cn == k && p_slot == (f_wcnt[k] ? 5'd22 : 5'd23));
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_rq_age <= 3'd7;
+      f_wc     <= 2'd0;
+    end else if (req_valid) begin
+      f_rq_age <= 3'd0;
+      f_wc     <= 2'd0;
+    end else begin
+      f_rq_age <= (f_rq_age == 3'd7) ? f_rq_age : f_rq_age + 3'd1;
+      if (p_b_st == B_WAIT) f_wc <= (f_wc == 2'd2) ? f_wc : f_wc + 2'd1;
+    end
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      if (rst) begin
+        f_wlive[k] <= 1'b0;
+        f_wage[k]  <= 8'd0;
+      end else if (p_pend_set[k]) begin
+        f_wlive[k]  <= 1'b1;
+        f_wage[k]   <= 8'd0;
+        f_wrq[k]    <= (f_rq_age >= 3'd5) ? 3'd7 : f_rq_age + 3'd2;  // (the answer: a clock on)
+        f_wcnt[k]   <= p_b_wr && p_b_word == OFF_CNT_LO;
+        f_nowait[k] <= f_wc == 2'd1;
+      end else begin
+        if (f_act[k]) f_wlive[k] <= 1'b0;
+        f_wage[k] <= (f_wage[k] == 8'hFF) ? f_wage[k] : f_wage[k] + 8'd1;
+      end
+    end
+  end
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      // the bus's request: its clocks so far, by state, when it did not wait (B_WAIT one clock;
+      // only a COUNT_LO write with some byte lanes off reads before it posts)
+      assert (p_b_st == B_IDLE ? (!f_out_q || resp_valid) : f_out_q);
+      if (p_b_st == B_WAIT && f_wc == 2'd0) assert (f_rq_age == 3'd0);
+      if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST || p_b_st == B_DONE)
+        assert (f_wc != 2'd0);
+      if ((p_b_st == B_RD1 || p_b_st == B_RD2) && p_b_wr) assert (p_b_word == OFF_CNT_LO);
+      if (f_wc == 2'd1) begin
+        if (p_b_st == B_RD1) assert (f_rq_age == 3'd1);
+        if (p_b_st == B_RD2) assert (f_rq_age == 3'd2);
+        if (p_b_st == B_POST) assert (f_rq_age == 3'd1 || (f_rq_age == 3'd3 && p_b_word == OFF_CNT_LO));
+        if (p_b_st == B_DONE && p_b_wr) assert (f_rq_age == 3'd2 || (f_rq_age == 3'd4 && p_b_word == OFF_CNT_LO));
+      end
+      for (k = 0; k < CHANNELS; k = k + 1) begin
+        if (f_wlive[k]) begin
+          // the RDL's bounds
+          assert (f_wage[k] <= (p_pend_st[k] ? P + 22 : P + 14));
+          if (f_act[k] && f_nowait[k])
+            assert ({5'd0, f_wrq[k]} + f_wage[k] <= (p_pend_st[k] ? P + 26 : P + 18));
+          // where the write is: waiting for its take (slot 9 of the visit before the lane's read,
+          // a state write's slot 21 of the channel's visit), taken and waiting to act; a write
+          // that did not wait was answered 4 clocks after its request (a COUNT_LO write with some
+          // byte lanes off: 6, after it read the count)
+          assert (p_pend[k] || p_busy[k]);
+          if (f_nowait[k]) assert (f_wrq[k] <= ((f_wcnt[k] && !p_pend_st[k]) ? 3'd6 : 3'd4));
+          if (f_wcnt[k]) assert (!p_pend_st[k]);
+          if (!p_pend_st[k]) begin
+            if (p_pend[k]) assert (f_wage[k] + until(k, 5'd9, p_cn, p_slot) <= P - 1);
+            // (taken in slot 9 at most P - 1 clocks after the answer, acts in slot 23 or 22)
+            if (p_busy[k]) assert (p_cn == k && p_n_taken && p_slot >= 5'd10 &&
+                                   p_slot <= (f_wcnt[k] ? 5'd22 : 5'd23) &&
+                                   f_wage[k] + 9 <= P - 1 + p_slot);
+          end else begin
+            if (p_pend[k]) assert (f_wage[k] + until(k, 5'd21, p_cp, p_slot) <= P - 1);
+            // (taken in slot 21 at most P - 1 clocks after the answer, written back by slot 19 of
+            // the visit after)
+            if (p_busy[k]) assert ((p_cp == k && p_e_taken && p_slot >= 5'd22 &&
+                                    f_wage[k] + 21 <= P - 1 + p_slot) ||
+                                   (p_wr_on && p_cw == k && p_w_taken && p_slot <= 5'd19 &&
+                                    f_wage[k] <= P + 2 + p_slot));
+          end
+        end else begin
+          assert (!p_pend[k] && (!p_busy[k] || !p_pend_st[k]));
+        end
+      end
+    end
+  end
+
 `ifdef ENGINE_DATA
   // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (tasks data, data_ch3)
   // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI),
@@ -303,7 +425,6 @@ module enc_qei_engine_formal #(
   localparam integer MOT_W = `ENC_QEI_ENGINE_MOT_W(CHANNELS);
   localparam integer TIM_W = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
   localparam integer ERR_W = `ENC_QEI_ENGINE_ERR_W(CHANNELS);
-  `include "enc_qei_regs.vh"
   `include "enc_qei_lane.vh"
   localparam [63:0] SZ       = (64'd1 << COUNT_W) - 64'd1;
   localparam [63:0] PRE_RST  = {ENC_QEI_PRESET_HI_RESET, ENC_QEI_PRESET_LO_RESET} & SZ;
@@ -347,8 +468,6 @@ module enc_qei_engine_formal #(
   (* keep *) wire [63:0]         p_wdata;    // eng.wdata
   (* keep *) wire [63:0]         p_wmask;    // eng.wmask
   (* keep *) wire [CHANNELS-1:0] p_fresh;    // eng.fresh_q
-  (* keep *) wire                p_b_wr;     // eng.b_wr_q
-  (* keep *) wire [5:0]          p_b_word;   // eng.b_word_q
   (* keep *) wire [31:0]         p_b_rdata;  // eng.b_rdata_q
   (* keep *) wire                p_ip_fresh; // eng.ip_fresh_q: c(v - 1) was fresh at its visit
   (* keep *) wire [1:0]          p_ip_pre;   // eng.ip_pre_q: its write's PRESET halves
