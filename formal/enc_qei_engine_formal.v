@@ -32,7 +32,8 @@
 //     posted write stays waiting or busy until it is completed (the wrapper's own count of posted
 //     minus completed writes is pend | busy);
 //   - a write acts within the RDL's bounds (CAPS.ENGINE shared, (2)): P + 14 clocks after its
-//     answer, P + 18 after its request (a state write: P + 22, P + 26): see that section.
+//     answer, P + 18 after its request (a state write: P + 22, P + 26), and a read right after it
+//     is answered within P + 62 of its answer, P + 66 of its request (see that section).
 // With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET,
 // CEILING and the snapshot's words, for one channel f (any, fixed; the bus writes any of its
 // registers but COUNT_HI): see the section at the end.
@@ -296,6 +297,11 @@ module enc_qei_engine_formal #(
   reg  [2:0]          f_rq_age;   // clocks since the bus's request, less 1 (7: more)
   reg  [1:0]          f_wc;       // ... its clocks in B_WAIT so far (2: more than one)
   reg  [CHANNELS-1:0] f_act;      // the write acts in this clock (combinational)
+  // a read requested while a write of its channel is not stored yet: it waits for it (the
+  // bounds: below)
+  reg                 f_rdw;      // such a read is in flight
+  reg  [3:0]          f_rdw_ch;   // ... of this channel
+  reg  [7:0]          f_stake [0:CHANNELS-1];  // a taken write's clocks since its take
 
   // clocks from now to the next clock with slot s and channel field (c(v + 1) or c(v)) k
   function [7:0] until;
@@ -316,6 +322,29 @@ module enc_qei_engine_formal #(
     end
   end
 
+  always @(*) begin
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      // a taken write's clocks since its take, from where it is (slot 9 of c(v + 1) = k; a state
+      // write's slot 21 of c(v) = k; the write-back in c(v - 1) = k's slots 0 .. 19)
+      if (!p_pend_st[k])
+        f_stake[k] = (p_cn == k && p_n_taken && p_slot >= 5'd10) ? {3'd0, p_slot} - 8'd9 :
+                     (p_cp == k && p_p_taken) ? 8'd15 + p_slot : 8'd39 + p_slot;
+      else
+        f_stake[k] = (p_cp == k && p_slot >= 5'd22) ? {3'd0, p_slot} - 8'd21 : 8'd3 + p_slot;
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_rdw <= 1'b0;
+    end else if (req_valid) begin
+      f_rdw    <= !req_write && (f_owed[req_ch] != 2'd0);
+      f_rdw_ch <= req_ch;
+    end else if (resp_valid) begin
+      f_rdw <= 1'b0;
+    end
+  end
+
   always @(posedge clk) begin
     if (rst) begin
       f_rq_age <= 3'd7;
@@ -329,8 +358,11 @@ module enc_qei_engine_formal #(
     end
     for (k = 0; k < CHANNELS; k = k + 1) begin
       if (rst) begin
-        f_wlive[k] <= 1'b0;
-        f_wage[k]  <= 8'd0;
+        f_wlive[k]  <= 1'b0;
+        f_wage[k]   <= 8'd0;
+        f_wrq[k]    <= 3'd7;
+        f_wcnt[k]   <= 1'b0;
+        f_nowait[k] <= 1'b0;
       end else if (p_pend_set[k]) begin
         f_wlive[k]  <= 1'b1;
         f_wage[k]   <= 8'd0;
@@ -370,8 +402,6 @@ module enc_qei_engine_formal #(
           // that did not wait was answered 4 clocks after its request (a COUNT_LO write with some
           // byte lanes off: 6, after it read the count)
           assert (p_pend[k] || p_busy[k]);
-          if (f_nowait[k]) assert (f_wrq[k] <= ((f_wcnt[k] && !p_pend_st[k]) ? 3'd6 : 3'd4));
-          if (f_wcnt[k]) assert (!p_pend_st[k]);
           if (!p_pend_st[k]) begin
             if (p_pend[k]) assert (f_wage[k] + until(k, 5'd9, p_cn, p_slot) <= P - 1);
             // (taken in slot 9 at most P - 1 clocks after the answer, acts in slot 23 or 22)
@@ -390,6 +420,38 @@ module enc_qei_engine_formal #(
         end else begin
           assert (!p_pend[k] && (!p_busy[k] || !p_pend_st[k]));
         end
+        // the channel's last write: answered 4 clocks after its request when it did not wait (a
+        // COUNT_LO write with some byte lanes off: 6)
+        if (f_nowait[k]) assert (f_wrq[k] == 3'd4 || (f_wrq[k] == 3'd6 && f_wcnt[k]));
+        if (f_wcnt[k]) assert (!p_pend_st[k]);
+        // a taken write (acted or not): taken at most P - 1 clocks after its answer, stored by
+        // its write-back (58 clocks after the take; a state write 22)
+        if (p_busy[k]) begin
+          assert (f_wage[k] <= P - 1 + f_stake[k]);
+          assert (f_stake[k] <= (p_pend_st[k] ? 8'd22 : 8'd58));
+          if (p_done[k]) assert (f_stake[k] == (p_pend_st[k] ? 8'd22 : 8'd58));
+        end
+        if (p_pend[k]) assert (f_wage[k] <= P - 1);
+      end
+      // a read that waited for a write of its channel: answered 5 clocks after the write is
+      // stored at the latest (B_WAIT, B_RD1, B_RD2, B_DONE); by the RDL, P + 62 clocks after the
+      // write's answer (a state write: P + 26), and when that write did not wait itself P + 66
+      // after its request (a state write: P + 30; a COUNT_LO write with some byte lanes off, which
+      // is answered 6 clocks after its request: P + 68)
+      if (f_rdw) begin
+        assert (f_rdw_ch < CHANNELS && (p_b_st == B_IDLE ? resp_valid :
+                                         (p_b_ch == f_rdw_ch && !p_b_wr && p_b_st != B_POST)));
+        if (p_b_st != B_WAIT) assert (!(|((p_pend | p_busy) & (1 << f_rdw_ch))));
+        if (!(|((p_pend | p_busy) & (1 << f_rdw_ch))))
+          assert (f_wage[f_rdw_ch] + ((p_b_st == B_WAIT) ? 5 : (p_b_st == B_RD1) ? 4 :
+                                      (p_b_st == B_RD2) ? 3 : (p_b_st == B_DONE) ? 2 : 1)
+                  <= (p_pend_st[f_rdw_ch] ? P + 27 : P + 63));
+      end
+      if (f_rdw && resp_valid) begin
+        assert (f_wage[f_rdw_ch] <= (p_pend_st[f_rdw_ch] ? P + 26 : P + 62));
+        if (f_nowait[f_rdw_ch])
+          assert ({5'd0, f_wrq[f_rdw_ch]} + f_wage[f_rdw_ch] <=
+                  (p_pend_st[f_rdw_ch] ? P + 30 : (f_wrq[f_rdw_ch] == 3'd6) ? P + 68 : P + 66));
       end
     end
   end

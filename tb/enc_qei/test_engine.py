@@ -13,7 +13,7 @@ the same, shown at once):
   COUNT_LO write), or P + 26 (EVENTS, QERR_COUNT: on what a read could show at the request, an
   event after it stays), in order with the reads and writes after it; a read right after a write
   sees it and is answered at most P + 66 clocks after the write's request (P + 30 after a state
-  write), and at some phase that late;
+  write, P + 68 after a COUNT_LO write with some byte lanes off), and at some phase that late;
 - every value exact: independent clock-exact random walks on every channel at the count-rate bound
   with index presets and latches, global snapshots every few hundred clocks, each channel against
   its own model; channels isolated from each other's bus traffic; reset in mid-motion;
@@ -38,8 +38,9 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from enctools.qei.bus import WbRaw, signed
 from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
-                              ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT, ENGINE_STATE_WAIT,
-                              ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin, build_name,
+                              ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT,
+                              ENGINE_STATE_WAIT, ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin,
+                              build_name,
                               channel_envs, engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
 from enctools.qei.stimulus import ClockWalk, pulse_rst
@@ -460,22 +461,25 @@ async def write_effect(dut):
 async def read_after_write_wait(dut):
     """A write of a channel, then at once a read of the same register (it must see the write),
     at every phase of the engine's visits: the read is answered at most P + ENGINE_WAIT clocks
-    after the write's request (a state write, IRQ_EN: P + ENGINE_STATE_WAIT; the RDL), and at some
-    phase within 2 clocks of that (the bound is the real one).
+    after the write's request (a COUNT_LO write with byte lanes 0 and 1 only: P + ENGINE_PART_WAIT;
+    a state write, IRQ_EN: P + ENGINE_STATE_WAIT; the RDL), and at some phase within 2 clocks of
+    that (the bound is the real one). The channels stand still (COUNT reads back as written).
     Per-channel build: the read answered PER_CHANNEL_ANSWER after its own request."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     raw = WbRaw(dut)
     p = engine_period(n) if env.engine else 2
     worst = {}
-    for reg, mask, bound in (("PRESET_LO", 0xFFFFFFFF, ENGINE_WAIT),
-                             ("IRQ_EN", 0x3FF, ENGINE_STATE_WAIT)):
+    for reg, mask, sel, bound in (("PRESET_LO", 0xFFFFFFFF, 0xF, ENGINE_WAIT),
+                                  ("COUNT_LO", 0xFFFF, 0x3, ENGINE_PART_WAIT),
+                                  ("IRQ_EN", 0x3FF, 0xF, ENGINE_STATE_WAIT)):
         worst[reg] = 0
         for rel in range(p):
             k = rng.randrange(n)
-            value = rng.getrandbits(32) & mask
+            old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
+            value = (old & ~mask) | (rng.getrandbits(32) & mask)
             await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
-            w, _, _ = await raw.access(addr(reg, k), value)
+            w, _, _ = await raw.access(addr(reg, k), value, sel=sel)
             r, got, _ = await raw.access(addr(reg, k))
             done = int(raw.tb.value)
             assert got == value, f"channel {k}: {reg} written {value:#x}, read right after: {got:#x}"
@@ -909,6 +913,7 @@ def test_rdl_says_the_bounds():
         "ENGINE_STATE_ACT": r"COUNT_HI acts \(irq included\) at most P \+ (\d+) clocks",
         "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
         "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
+        "ENGINE_PART_WAIT": r"and P \+ (\d+) after a COUNT_LO write with some but not all byte enables set",
         "ENGINE_ANSWER": r"a write of a channel register is answered (\d+) clocks after its request",
         "ENGINE_READ_ANSWER": r"a read (\d+) clocks after its request",
         "ENGINE_PART_ANSWER": r"a COUNT_LO write with some but not all byte enables set (\d+)",

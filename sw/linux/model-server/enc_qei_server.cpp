@@ -26,7 +26,8 @@
 // The RDL bounds the answer to an access: 2 clocks after its request on a per_channel build; on
 // the shared engine 6 (a read 5, a write 4, a COUNT_LO write with some byte lanes 6, a COUNT_LO
 // read of another channel 6), and an access of a channel waits until that channel's writes are
-// stored: one right after a write is answered at most P + 66 clocks after the write's request.
+// stored: one right after a write is answered at most P + 66 clocks after the write's request
+// (P + 68 after a COUNT_LO write with some byte lanes off, which the driver does not make).
 // The server holds every access to that bound, counted from the last write of the same 0x100-byte
 // page (a channel); for a write that itself waited for an earlier one, from its answer less 6
 // clocks, as if it had been requested then and not waited (the RDL states the bound for a write

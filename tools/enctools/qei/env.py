@@ -42,6 +42,7 @@ ENGINE_IRQ = 44         # irq and IRQ_SUMMARY rise and fall at most P + 44 later
 ENGINE_ACT = 18         # a write of a register the counting uses acts at most P + 18 after its request
 ENGINE_STATE_ACT = 26   # a write of EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN or COUNT_HI: P + 26
 ENGINE_WAIT = 66        # a read right after a write of its channel is answered at most P + 66 after the write's request
+ENGINE_PART_WAIT = 68   # ... after a COUNT_LO write with some but not all byte enables: P + 68
 ENGINE_STATE_WAIT = 30  # ... after a state write (EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN, COUNT_HI): P + 30
 ENGINE_ANSWER = 4       # otherwise a channel register write is answered 4 clocks after its request
 ENGINE_READ_ANSWER = 5  # ... a read 5
