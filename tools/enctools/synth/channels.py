@@ -245,12 +245,13 @@ def lane_parts() -> LaneParts | None:
 # The floor of a lane: enc_qei_floor_bank (tools/enctools/synth/floor/), FLOOR_LANES lanes that
 # keep only what must see every clock (enc_qei_floor_lane's header lists it and what it leaves
 # out), read through the same one-hot AND-OR, flattened as the engine builds are. At each P of
-# FLOOR_P: the clocks between two reads of a lane (LANE_CHANNELS: one lane read a clock; the
-# engine's 24 clocks a visit).
+# FLOOR_P: the clocks between two reads of a lane (FLOOR_LANES: one lane read a clock;
+# FLOOR_VISIT a lane: the engine's schedule).
 FLOOR_FILES = ("rtl/enc_filter_rt.v", "tools/enctools/synth/floor/enc_qei_floor_lane.v",
                "tools/enctools/synth/floor/enc_qei_floor_bank.v")
 FLOOR_LANES = 16
-FLOOR_P = (FLOOR_LANES, 24 * FLOOR_LANES)
+FLOOR_VISIT = 24  # the engine's clocks a visit (ENC_QEI_ENGINE_V of rtl/enc_qei_lane_w.vh)
+FLOOR_P = (FLOOR_LANES, FLOOR_VISIT * FLOOR_LANES)
 
 
 @dataclass(frozen=True)
@@ -311,8 +312,9 @@ def floor_markdown(floors: list[Floor], lane: LaneParts | None) -> list[str]:
         "(EDGE, gate, ARM, ONESHOT) and the snapshot's capture of both, the error counts and STATUS; "
         "it leaves the count's loads, exact OVERFLOW / UNDERFLOW, the other count functions and "
         "every time stamp but `since` to an engine, and has no engine, no bus and no count. It is "
-        "read through the same one-hot AND-OR. P: the clocks between two reads of a lane (16: one "
-        f"lane read every clock; {24 * FLOOR_LANES}: the engine's 24 clocks a visit), which sets "
+        f"read through the same one-hot AND-OR. P: the clocks between two reads of a lane "
+        f"({FLOOR_LANES}: one lane read every clock; {FLOOR_VISIT * FLOOR_LANES}: the engine's "
+        f"{FLOOR_VISIT} clocks a visit), which sets "
         "its widths. Per lane: its LUT4 with the hierarchy kept (filters included, the OR of the "
         f"lanes not), and the flattened bank's LUT4 over {FLOOR_LANES}." + ours, "",
         f"| P | record bits | one lane, hierarchy kept | of it: filters | {FLOOR_LANES} lanes, "
