@@ -9,8 +9,6 @@ to its saturation."""
 
 from __future__ import annotations
 
-import random
-
 from cocotb.triggers import FallingEdge, RisingEdge, Timer
 
 from enctools.harness import run
@@ -75,6 +73,9 @@ class Lane:
         await self.clocks(12)  # (the filters and the decode settle)
 
 
+INPUTS = {"a_in": 0, "b_in": 0, "z_in": 0, "tick": 1, "snap": 0, "rd": 0, "cfg_we": 0, "cfg": 0}
+
+
 def cfg_word(last: int, edge_rising: int = 1, gate: tuple | None = None, arm: int = 1,
              oneshot: int = 0) -> int:
     """The configuration: FILTER_LEN - 1, EDGE, the gate ((A, B) or None: off), ARM, ONESHOT."""
@@ -85,8 +86,7 @@ def cfg_word(last: int, edge_rising: int = 1, gate: tuple | None = None, arm: in
 @cocotb_test()
 async def walk_reads_latches(dut):
     """Steps, glitches and illegal jumps between random reads; index latches and snapshots."""
-    rng = await start(dut, 10_000, inputs={"a_in": 0, "b_in": 0, "z_in": 0, "tick": 1, "snap": 0,
-                                           "rd": 0, "cfg_we": 0, "cfg": 0})
+    rng = await start(dut, 10_000, inputs=INPUTS)
     lane = Lane(dut)
     mask = (1 << ACC_W) - 1
     rec = await lane.read(cfg_word(last=1))
@@ -163,8 +163,7 @@ async def walk_reads_latches(dut):
 async def since_counts_clocks(dut):
     """`since` is 0 in the clock after a step and counts clocks (tick every clock) up to all
     ones; a snapshot request captures it and the accumulator."""
-    rng = await start(dut, 10_000, inputs={"a_in": 0, "b_in": 0, "z_in": 0, "tick": 1, "snap": 0,
-                                           "rd": 0, "cfg_we": 0, "cfg": 0})
+    await start(dut, 10_000, inputs=INPUTS)
     lane = Lane(dut)
     await lane.read(cfg_word(last=0))
     await lane.rest()
