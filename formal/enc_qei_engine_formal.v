@@ -404,18 +404,14 @@ module enc_qei_engine_formal #(
           assert (p_pend[k] || p_busy[k]);
           if (!p_pend_st[k]) begin
             if (p_pend[k]) assert (f_wage[k] + until(k, 5'd9, p_cn, p_slot) <= P - 1);
-            // (taken in slot 9 at most P - 1 clocks after the answer, acts in slot 23 or 22)
+            // (taken in slot 9, acts in slot 23 or 22 of that visit; its age: below)
             if (p_busy[k]) assert (p_cn == k && p_n_taken && p_slot >= 5'd10 &&
-                                   p_slot <= (f_wcnt[k] ? 5'd22 : 5'd23) &&
-                                   f_wage[k] + 9 <= P - 1 + p_slot);
+                                   p_slot <= (f_wcnt[k] ? 5'd22 : 5'd23));
           end else begin
             if (p_pend[k]) assert (f_wage[k] + until(k, 5'd21, p_cp, p_slot) <= P - 1);
-            // (taken in slot 21 at most P - 1 clocks after the answer, written back by slot 19 of
-            // the visit after)
-            if (p_busy[k]) assert ((p_cp == k && p_e_taken && p_slot >= 5'd22 &&
-                                    f_wage[k] + 21 <= P - 1 + p_slot) ||
-                                   (p_wr_on && p_cw == k && p_w_taken && p_slot <= 5'd19 &&
-                                    f_wage[k] <= P + 2 + p_slot));
+            // (taken in slot 21, written back by slot 19 of the visit after; its age: below)
+            if (p_busy[k]) assert ((p_cp == k && p_e_taken && p_slot >= 5'd22) ||
+                                   (p_wr_on && p_cw == k && p_w_taken && p_slot <= 5'd19));
           end
         end else begin
           assert (!p_pend[k] && (!p_busy[k] || !p_pend_st[k]));
