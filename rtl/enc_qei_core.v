@@ -351,15 +351,15 @@ module enc_qei_core #(
   end
 
   // The next clock's flags, each an AND-OR over the cases of this clock (the select, early; the
-  // case's candidate value of the flag, late), with rst as one more case (count 0, STOPPED 0)
-  // and +1 split by whether it wraps (count_q at the maximum: in the free range only, a bounded
-  // range stops or wraps there first, the maximum being >= every ceiling).
-  // Cases:         7 rst   6 load   5 hold   4 +1   3 +1 wrapping   2 -1   1 ->0   0 ->CEILING
-  wire [7:0] sel = rst ? 8'b1000_0000 :
-                   {1'b0, load_q, s_hold, s_inc & ~at_max, s_inc & at_max, s_dec, s_zero, s_ceil};
+  // case's candidate value of the flag, late), with rst as one more case (count 0, STOPPED 0).
+  // +1 wraps to 0 at the maximum (in the free range only: a bounded range stops or wraps there
+  // first, the maximum being >= every ceiling); whether it does is in +1's candidates (at_max,
+  // late), not in the selects (Fmax: the 32-bit comparison stays off the select paths).
+  // Cases:         6 rst   5 load   4 hold   3 +1   2 -1   1 ->0   0 ->CEILING
+  wire [6:0] sel = rst ? 7'b100_0000 : {1'b0, load_q, s_hold, s_inc, s_dec, s_zero, s_ceil};
   // zero: count_d == 0
   wire is_one = (count_q == {{(COUNT_W-1){1'b0}}, 1'b1});
-  wire [7:0] z_cand = {1'b1, load_zero_q, zero_q, 1'b0, 1'b1, is_one, 1'b1, ceil_now_zero};
+  wire [6:0] z_cand = {1'b1, load_zero_q, zero_q, at_max, is_one, 1'b1, ceil_now_zero};
   // zero: the next count is 0 (every range)
   always @(posedge clk) begin
     zero_q <= |(sel & z_cand);
@@ -402,12 +402,12 @@ module enc_qei_core #(
       // after its carry chains, and its flag one LUT later)
       (* keep *) wire cand_hold;  // count_q >= N
       assign cand_hold = ceil_nx_zero_q | gt_n(count_q, ceil_nx_m1n_q);
-      (* keep *) wire cand_inc;   // count_q + 1 >= N (no wrap)
-      assign cand_inc = ceil_nx_le1_q | gt_n(count_q, ceil_nx_m2n_q);
+      (* keep *) wire cand_inc;   // count_q + 1 >= N; at the maximum it wraps to 0, >= N only for N = 0
+      assign cand_inc = (ceil_nx_le1_q | gt_n(count_q, ceil_nx_m2n_q)) & (~at_max | ceil_nx_zero_q);
       (* keep *) wire cand_dec;   // count_q - 1 >= N (count_q > 0), or the maximum (count_q = 0)
       assign cand_dec = at_zero | gt_n(count_q, ceil_nx_n_q);
-      wire [7:0] c_cand = {ceil_nx_zero_q, load_ge_q, cand_hold, cand_inc, ceil_nx_zero_q, cand_dec,
-                           ceil_nx_zero_q, ceil_wrap_ge_q};
+      wire [6:0] c_cand = {ceil_nx_zero_q, load_ge_q, cand_hold, cand_inc, cand_dec, ceil_nx_zero_q,
+                           ceil_wrap_ge_q};
       // The range gates the selects (early), not the flags (late). The at-CEILING flags are each
       // kept as two partial registers (their OR is the flag), so that a comparator's carry chains
       // feed two LUT levels only, the candidate and its flag: (Fmax)
@@ -421,19 +421,22 @@ module enc_qei_core #(
         end
       endfunction
 
-      wire       stop_n  = ~rst & stopped_d;  // (a stop holds in any RANGE until COUNT is written)
-      wire [7:0] sel_mod = sel & {8{range == ENC_QEI_RANGE_MODULO}};                            // next: modulo
-      wire [7:0] sel_lim = sel & {8{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
-      wire [7:0] sel_bnd = sel & {8{range != ENC_QEI_RANGE_FREE}};                              // bounded
+      wire       stop_n  = ~rst & stopped_d;
+      // (a stop holds in any RANGE until COUNT is written, and a stopped count does not wrap: the
+      // modulo selects are gated by it, early, so that the wrap flags' late candidates meet no
+      // gate after them; Fmax)
+      wire [6:0] sel_mod = sel & {7{(range == ENC_QEI_RANGE_MODULO) & ~stop_n}};                // next: modulo, not stopped
+      wire [6:0] sel_lim = sel & {7{(range == ENC_QEI_RANGE_LIMIT) | (range == ENC_QEI_RANGE_NON_RECYCLE)}}; // limit, n_r
+      wire [6:0] sel_bnd = sel & {7{range != ENC_QEI_RANGE_FREE}};                              // bounded
       // (keep: the late candidates' selects are nets, so that each partial flag is one LUT)
       (* keep *) wire [2:0] late_mod;
-      assign late_mod = {sel_mod[5], sel_mod[4], sel_mod[2]};
+      assign late_mod = {sel_mod[4], sel_mod[3], sel_mod[2]};
       (* keep *) wire [2:0] late_lim;
-      assign late_lim = {sel_lim[5], sel_lim[4], sel_lim[2]};
+      assign late_lim = {sel_lim[4], sel_lim[3], sel_lim[2]};
       (* keep *) wire [2:0] late_bnd;
-      assign late_bnd = {sel_bnd[5], sel_bnd[4], sel_bnd[2]};
+      assign late_bnd = {sel_bnd[4], sel_bnd[3], sel_bnd[2]};
       // (keep: the early cases' terms are ORed apart from the late ones, for the same reason)
-      localparam [7:0] EARLY = 8'b1100_1011;  // rst, load, +1 wrapping, ->0, ->CEILING
+      localparam [6:0] EARLY = 7'b110_0011;   // rst, load, ->0, ->CEILING
       (* keep *) wire [2:0] early_g;           // {modulo, limit, bounded}
       assign early_g = {|(sel_mod & c_cand & EARLY), |(sel_lim & c_cand & EARLY),
                         |(sel_bnd & c_cand & EARLY)};
@@ -442,10 +445,10 @@ module enc_qei_core #(
       reg       dn_wrap_r, dn_lim_r, dn_blk_r, stop_r;
 
       always @(posedge clk) begin
-        up_wrap_r <= parts(late_mod, early_g[2]) & {2{~stop_n}};  // (stopped: no wrap either)
+        up_wrap_r <= parts(late_mod, early_g[2]);
         up_lim_r  <= parts(late_lim, early_g[1]);
         up_blk_r  <= parts(late_bnd, early_g[0]);
-        dn_wrap_r <= ~stop_n & (|(sel_mod & z_cand));
+        dn_wrap_r <= |(sel_mod & z_cand);
         dn_lim_r  <= |(sel_lim & z_cand);
         dn_blk_r  <= stop_n | (|(sel_bnd & z_cand));
         stop_r    <= stop_n;
