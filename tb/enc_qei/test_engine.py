@@ -39,7 +39,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 from enctools.qei.bus import WbRaw, signed
 from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
                               ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT,
-                              ENGINE_STATE_WAIT, ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin,
+                              ENGINE_SAVE_WAIT, ENGINE_STATE_WAIT, ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin,
                               build_name,
                               channel_envs, engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
@@ -48,8 +48,8 @@ from enctools.regmap import addr, built_mask, event_bits, field, pack, regmap, u
 from enctools.tb import cocotb_test
 
 # (top, CHANNELS, ENGINE): the reference build with a datapath per channel, then the engine
-ENGINE_CONFIGS = (("enc_qei_wb", 1, 0), ("enc_qei_wb", 1, 1), ("enc_qei_wb", 3, 1),
-                  ("enc_qei_wb", 16, 1))
+ENGINE_CONFIGS = (("enc_qei_wb", 1, 0, 32), ("enc_qei_wb", 1, 1, 32), ("enc_qei_wb", 3, 1, 32),
+                  ("enc_qei_wb", 16, 1, 32), ("enc_qei_wb", 2, 1, 64))
 
 CHAN_REGS = tuple(r for r, x in regmap().items() if x.group == "chan")
 TRAFFIC = ("CTRL", "COUNT_LO", "COUNT_HI", "PRESET_LO", "PRESET_HI", "INDEX_CTRL", "EVENTS",
@@ -500,6 +500,53 @@ async def read_after_write_wait(dut):
 
 
 @cocotb_test()
+async def count_hi_save_wait(dut):
+    """COUNT_W > 32 with two channels or more: a COUNT_LO read of channel k after one of channel j
+    stores j's COUNT_HI latch (the high word of j's count at that read) in the engine's memory;
+    COUNT_HI of j reads that word afterwards, and a read or write of j requested right after the
+    read of k is answered at most P + ENGINE_SAVE_WAIT clocks after that read's request (the RDL),
+    at every phase of the visits, and at some phase within 2 clocks of that."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    if not env.engine or env.count_w <= 32 or n < 2:
+        dut._log.info("skipped: COUNT_W %d, %d channel(s)", env.count_w, n)
+        return
+    raw = WbRaw(dut)
+    p = engine_period(n)
+    worst = worst_ans = 0
+    for rel, write in [(rel, w) for rel in range(p) for w in (False, True)]:
+        j = rng.randrange(n)
+        k = rng.choice([c for c in range(n) if c != j])
+        hi = rng.getrandbits(32) & ((1 << (env.count_w - 32)) - 1)
+        await raw.access(addr("COUNT_HI", j), hi)
+        await raw.access(addr("COUNT_LO", j), rng.getrandbits(32))
+        await ClockCycles(dut.clk, p + ENGINE_WAIT)
+        await raw.access(addr("COUNT_LO", j))  # COUNT_HI's latch: j's
+        await at_phase(dut, p, rel)
+        r, _, _ = await raw.access(addr("COUNT_LO", k))  # ... stored, the latch k's
+        r_done = int(raw.tb.value)
+        dut._log.debug("k read answered %d", r_done - r)
+        if write:
+            await raw.access(addr("IRQ_EN", j), 0)
+        else:
+            await raw.access(addr("PRESET_LO", j))
+        done = int(raw.tb.value)
+        assert done - r <= p + ENGINE_SAVE_WAIT, \
+            f"channel {j}: {'a write' if write else 'a read'} right after a COUNT_LO read of channel " \
+            f"{k} answered {done - r} clocks after that read's request (bound P + {ENGINE_SAVE_WAIT}, P {p})"
+        worst = max(worst, done - r - p)
+        worst_ans = max(worst_ans, done - r_done - p)
+        got = (await raw.access(addr("COUNT_HI", j)))[1]
+        assert got == hi, f"channel {j}: COUNT_HI {got:#x} after its latch was stored, {hi:#x} written"
+    dut._log.info("an access of channel j right after a COUNT_LO read of another channel answered at "
+                  "worst P + %d clocks after that read's request, P + %d after its answer (bound P + %d, P %d)", worst,
+                  worst_ans, ENGINE_SAVE_WAIT, p)
+    assert worst >= ENGINE_SAVE_WAIT - 2, \
+        f"the worst access after a latch was stored was answered at P + {worst}: the RDL's " \
+        f"P + {ENGINE_SAVE_WAIT} is loose"
+
+
+@cocotb_test()
 async def writes_once_in_order(dut):
     """Writes to one channel back to back, and reads right after them: each read gives what the
     writes before it wrote (PRESET_LO, IRQ_EN, INDEX_CTRL, a W1C of EVENTS); a SNAP_CTRL.CMD takes
@@ -914,6 +961,7 @@ def test_rdl_says_the_bounds():
         "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
         "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
         "ENGINE_PART_WAIT": r"and P \+ (\d+) after a COUNT_LO write with some but not all byte enables set",
+        "ENGINE_SAVE_WAIT": r"answered at most P \+ (\d+) clocks after the COUNT_LO read's request",
         "ENGINE_ANSWER": r"a write of a channel register is answered (\d+) clocks after its request",
         "ENGINE_READ_ANSWER": r"a read (\d+) clocks after its request",
         "ENGINE_PART_ANSWER": r"a COUNT_LO write with some but not all byte enables set (\d+)",
@@ -962,18 +1010,19 @@ def test_registers_state_their_bounds():
         missing = bounds - said.get(r, set())
         assert not missing, f"{r}: its RDL text does not state P + {sorted(missing)}"
     known = {env.ENGINE_SHOW, env.ENGINE_SHOW_COUNT, env.ENGINE_ACT, env.ENGINE_STATE_ACT,
-             env.ENGINE_WAIT, env.ENGINE_STATE_WAIT, env.ENGINE_IRQ}
+             env.ENGINE_WAIT, env.ENGINE_STATE_WAIT, env.ENGINE_IRQ, env.ENGINE_SAVE_WAIT}
     for r, bounds in said.items():
         assert bounds <= known, f"{r}: its RDL text states P + {sorted(bounds - known)}, a bound " \
                                 f"CAPS.ENGINE's text does not give"
 
 
-@pytest.mark.parametrize("top,channels,engine", ENGINE_CONFIGS,
-                         ids=[f"{t}-ch{c}" + ("-engine" if e else "") for t, c, e in ENGINE_CONFIGS])
-def test_engine(top, channels, engine):
+@pytest.mark.parametrize("top,channels,engine,count_w", ENGINE_CONFIGS,
+                         ids=[f"{t}-ch{c}" + ("" if w == 32 else f"-c{w}") + ("-engine" if e else "")
+                              for t, c, e, w in ENGINE_CONFIGS])
+def test_engine(top, channels, engine, count_w):
     from enctools.harness import run
 
     # (16 channels on Verilator whatever SIM says: Icarus takes about 30 times longer)
-    run(top, __name__, name=f"{build_name(top, 32, 32, 'lean', engine)}_ch{channels}",
-        parameters={"COUNT_W": 32, "TS_W": 32, "CHANNELS": channels, "PROFILE": PROFILES["lean"],
+    run(top, __name__, name=f"{build_name(top, count_w, 32, 'lean', engine)}_ch{channels}",
+        parameters={"COUNT_W": count_w, "TS_W": 32, "CHANNELS": channels, "PROFILE": PROFILES["lean"],
                     "ENGINE": engine}, sim="verilator" if channels > 3 else None)

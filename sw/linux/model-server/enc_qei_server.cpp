@@ -28,6 +28,9 @@
 // read of another channel 6), and an access of a channel waits until that channel's writes are
 // stored: one right after a write is answered at most P + 66 clocks after the write's request
 // (P + 68 after a COUNT_LO write with some byte lanes off, which the driver does not make).
+// With COUNT_W > 32, a COUNT_LO read of another channel than the last COUNT_LO read's stores that
+// channel's COUNT_HI latch, and an access of that channel requested right after waits for the
+// store: at most P + 29 clocks after that read's request.
 // The server holds every access to that bound, counted from the last write of the same 0x100-byte
 // page (a channel); for a write that itself waited for an earlier one, from its answer less 6
 // clocks, as if it had been requested then and not waited (the RDL states the bound for a write
@@ -76,6 +79,15 @@ uint64_t prev_request;
 constexpr int kPages = 64;  // 0x100-byte pages of the address space (a channel's registers)
 uint64_t last_write[kPages];  // each page's last write: its request, or for a write that waited
                               // its answer less answer_bound
+// COUNT_W > 32 on the shared engine with two channels or more: a COUNT_LO read of another channel
+// than the last COUNT_LO read's stores that channel's COUNT_HI latch, and an access of that
+// channel right after waits for the store: answered at most P + 29 clocks after the read's request
+bool save_rule;
+int save_bound;               // P + 29
+int latch_page = -1;          // the channel (page) whose COUNT_HI latch the engine holds
+bool saved[kPages];           // a latch store was made for the page ...
+uint64_t last_save[kPages];   // ... by the COUNT_LO read requested then
+constexpr uint32_t kCountLo = 0x10;  // COUNT_LO's offset in a channel's page
 
 void tick() {
     top->clk = 0;
@@ -117,9 +129,12 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
             *data = top->wb_dat_o;
             if (i > longest_answer)
                 longest_answer = i;
-            const uint64_t since_write = request + i - last_write[addr >> 8 & (kPages - 1)];
+            const int page = addr >> 8 & (kPages - 1);
+            const uint64_t since_write = request + i - last_write[page];
+            const bool after_save = saved[page] &&
+                request + i - last_save[page] <= static_cast<uint64_t>(save_bound);
             const bool late = i > answer_bound &&
-                since_write > static_cast<uint64_t>(after_write_bound);
+                since_write > static_cast<uint64_t>(after_write_bound) && !after_save;
             if (late && late_answers++ < 8)
                 fprintf(stderr, "enc_qei_server: late answer: a %s of 0x%03x answered %d clocks "
                         "after its request (clock %llu), %llu after a %s of 0x%03x\n",
@@ -138,6 +153,15 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     prev_addr = addr;
     prev_we = we;
     prev_request = request;
+    // a COUNT_LO read of another channel stores the latch of the channel read before (above)
+    const int page = addr >> 8 & (kPages - 1);
+    if (save_rule && !we && (addr & 0xff) == kCountLo && page < channels) {
+        if (latch_page >= 0 && latch_page != page) {
+            saved[latch_page] = true;
+            last_save[latch_page] = request;
+        }
+        latch_page = page;
+    }
     // a write that waited itself counts from its answer less answer_bound (see the top)
     if (we)
         last_write[addr >> 8 & (kPages - 1)] =
@@ -223,6 +247,8 @@ int main(int argc, char **argv) {
     const int settle_before = engine ? p + 22 : 0, settle_after = engine ? p + 44 : 0;
     if (engine)
         answer_bound = 6, after_write_bound = p + 66;
+    save_rule = engine && (caps & 0xff) > 32 && channels > 1;  // CAPS.COUNT_W
+    save_bound = p + 29;
     for (int k = 0; k < channels; k++)
         enc_stim_init(&stim[k], static_cast<unsigned>(k));
     drive_inputs();

@@ -43,6 +43,7 @@ ENGINE_ACT = 18         # a write of a register the counting uses acts at most P
 ENGINE_STATE_ACT = 26   # a write of EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN or COUNT_HI: P + 26
 ENGINE_WAIT = 66        # a read right after a write of its channel is answered at most P + 66 after the write's request
 ENGINE_PART_WAIT = 68   # ... after a COUNT_LO write with some but not all byte enables: P + 68
+ENGINE_SAVE_WAIT = 29   # COUNT_W > 32: an access of channel j right after a COUNT_LO read of another channel that stored j's COUNT_HI latch: P + 29 after that read's request
 ENGINE_STATE_WAIT = 30  # ... after a state write (EVENTS, QERR_COUNT, GLITCH_COUNT, IRQ_EN, COUNT_HI): P + 30
 ENGINE_ANSWER = 4       # otherwise a channel register write is answered 4 clocks after its request
 ENGINE_READ_ANSWER = 5  # ... a read 5
