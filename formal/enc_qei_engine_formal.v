@@ -495,21 +495,28 @@ module enc_qei_engine_formal #(
   // (W_STIME), SNAP_DELTA / SNAP_EDGE_DELTA (W_SDELTA), and their write slots
   localparam [4:0]  W_MOT = 5'd9, W_EDGE = 5'd11, W_SBASE = 5'd12, W_STIME = 5'd14,
                     W_SDELTA = 5'd15;
+  localparam [4:0]  W_HI = 5'd8;  // COUNT_HI's latch [31:0] and stage [63:32]: 0 (see below)
   localparam [4:0]  S_MOT = 5'd9, S_EDGE = 5'd10, S_SBASE = 5'd11, S_STIME = 5'd13, S_SDELTA = 5'd14;
   localparam [31:0] SZ_T = (TS_W >= 32) ? 32'hFFFFFFFF : ((32'd1 << TS_W) - 32'd1);
-  localparam integer NPEEK = 11;  // enc_qei_ram's F_PEEK
+  localparam integer NPEEK = 12;  // enc_qei_ram's F_PEEK
   localparam [5:0]  OFF_CNT = ENC_QEI_COUNT_LO[7:2], OFF_SCNT = ENC_QEI_SNAP_COUNT_LO[7:2],
                     OFF_ILAT = ENC_QEI_INDEX_LATCH_LO[7:2], OFF_PLAT = ENC_QEI_PROBE_LATCH_LO[7:2],
                     OFF_PRE = ENC_QEI_PRESET_LO[7:2], OFF_PRE_HI = ENC_QEI_PRESET_HI[7:2],
                     OFF_CEIL = ENC_QEI_CEILING_LO[7:2], OFF_CEIL_HI = ENC_QEI_CEILING_HI[7:2],
                     OFF_STIM = ENC_QEI_SNAP_TIME[7:2], OFF_SETIM = ENC_QEI_SNAP_EDGE_TIME[7:2],
                     OFF_SDEL = ENC_QEI_SNAP_DELTA[7:2], OFF_SEDEL = ENC_QEI_SNAP_EDGE_DELTA[7:2];
+  // the high halves (COUNT_W > 32: bits 63:32 of the word; 0 at COUNT_W <= 32) and COUNT_HI (the
+  // high word of the count as COUNT_LO's last read of f took it)
+  localparam [5:0]  OFF_CNT_HI = ENC_QEI_COUNT_HI[7:2], OFF_SCNT_HI = ENC_QEI_SNAP_COUNT_HI[7:2],
+                    OFF_ILAT_HI = ENC_QEI_INDEX_LATCH_HI[7:2],
+                    OFF_PLAT_HI = ENC_QEI_PROBE_LATCH_HI[7:2];
 
   (* anyconst *) reg [3:0] f_ch;
   wire [AW-1:0] a_cnt = {f_ch, W_CNT}, a_pre = {f_ch, W_PRESET}, a_ceil = {f_ch, W_CEIL};
   wire [AW-1:0] a_scnt = {f_ch, W_SCNT}, a_ilat = {f_ch, W_ILATCH}, a_plat = {f_ch, W_PLATCH};
   wire [AW-1:0] a_mot = {f_ch, W_MOT}, a_edge = {f_ch, W_EDGE}, a_sbase = {f_ch, W_SBASE};
   wire [AW-1:0] a_stim = {f_ch, W_STIME}, a_sdel = {f_ch, W_SDELTA};
+  wire [AW-1:0] a_hi = {f_ch, W_HI};
 
   (* keep *) wire [REC_W-1:0]    p_rec_or;   // eng.rec_or: the record of the lane read now
   (* keep *) wire [REC_W-1:0]    p_rec_q;    // eng.rec_q: c(v)'s
@@ -550,13 +557,19 @@ module enc_qei_engine_formal #(
   (* keep *) wire [63:0]         p_n_stime;  // eng.n_stime_q
   (* keep *) wire [63:0]         p_n_sdel;   // eng.n_sdelta_q
   (* keep *) wire [TS_W-1:0]     p_tv;       // eng.tv_q: the timebase at the read of c(v)
-  (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_sdel, a_stim, a_sbase, a_edge, a_mot, a_plat,
-                                                a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
+  (* keep *) wire [1:0]          p_ip_hi;    // eng.ip_hi_q: the write-back's COUNT_HI stage, latch
+  (* keep *) wire [63:0]         p_n_hi;     // eng.n_hi: c(v + 1)'s W_HI (COUNT_W > 32 only:
+  (* keep *) wire [63:0]         p_o_hi;     // eng.o_hi: c(v)'s           task data_w40)
+  (* keep *) wire                p_lat_valid;  // eng.lat_valid_q: COUNT_HI's latch (COUNT_W > 32
+  (* keep *) wire [3:0]          p_lat_ch;     // eng.lat_ch_q    only: connected by task data_w40)
+  (* keep *) wire [31:0]         p_lat_q;      // eng.lat_q
+  (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_hi, a_sdel, a_stim, a_sbase, a_edge, a_mot,
+                                                a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
   (* keep *) wire [NPEEK*4-1:0]  f_slot_addr = {NPEEK{f_ch}};  // -> eng.u_pend.f_peek_addr
   wire [63:0] m_cnt  = p_peek[0 +: 64],   m_pre  = p_peek[64 +: 64],  m_ceil = p_peek[128 +: 64];
   wire [63:0] m_scnt = p_peek[192 +: 64], m_ilat = p_peek[256 +: 64], m_plat = p_peek[320 +: 64];
   wire [63:0] m_mot  = p_peek[384 +: 64], m_edge = p_peek[448 +: 64], m_sbase = p_peek[512 +: 64];
-  wire [63:0] m_stim = p_peek[576 +: 64], m_sdel = p_peek[640 +: 64];
+  wire [63:0] m_stim = p_peek[576 +: 64], m_sdel = p_peek[640 +: 64], m_hi = p_peek[704 +: 64];
 
   // the reference: the record of f's last read (rst: channel 0's first visit takes the reset
   // record, 0); the count stored (f_sto) and the one stored before it (f_base: the count at the
@@ -567,6 +580,8 @@ module enc_qei_engine_formal #(
   reg  [63:0]      f_sto, f_base, f_scnt, f_ilat, f_plat;
   reg  [63:0]      f_sto_d, f_scnt_d, f_ilat_d, f_plat_d;
   reg  [31:0]      f_exp;  // what the bus read of f under way answers
+  reg              f_lat;   // a COUNT_LO read of f was taken: COUNT_HI answers its high word
+  reg  [31:0]      f_latv;  // ... this one
   reg              f_chk;  // ... one is under way, past its take
   reg              f_pk;     // the write in f's slot (or on its way there) reaches a watched word
   reg  [41:0]      f_px;     // ... and the slot holds this ({offset, byte enables, data}: a
@@ -623,21 +638,35 @@ module enc_qei_engine_formal #(
   wire             f_watched = p_b_word == OFF_CNT || p_b_word == OFF_SCNT || p_b_word == OFF_ILAT ||
                                p_b_word == OFF_PLAT || p_b_word == OFF_PRE || p_b_word == OFF_CEIL ||
                                p_b_word == OFF_STIM || p_b_word == OFF_SETIM ||
-                               p_b_word == OFF_SDEL || p_b_word == OFF_SEDEL;
+                               p_b_word == OFF_SDEL || p_b_word == OFF_SEDEL ||
+                               p_b_word == OFF_CNT_HI || p_b_word == OFF_SCNT_HI ||
+                               p_b_word == OFF_ILAT_HI || p_b_word == OFF_PLAT_HI ||
+                               p_b_word == OFF_PRE_HI || p_b_word == OFF_CEIL_HI;
   wire [63:0]      f_word_d = (p_b_word == OFF_CNT) ? f_sto_d : (p_b_word == OFF_SCNT) ? f_scnt_d :
                               (p_b_word == OFF_ILAT) ? f_ilat_d : (p_b_word == OFF_PLAT) ? f_plat_d :
                               (p_b_word == OFF_PRE) ? f_pre_d : (p_b_word == OFF_CEIL) ? f_ceil_d :
                               (p_b_word == OFF_STIM) ? f_stim_d :
                               (p_b_word == OFF_SETIM) ? {32'd0, f_stim_d[63:32]} :
-                              (p_b_word == OFF_SDEL) ? f_sdel_d : {32'd0, f_sdel_d[63:32]};
+                              (p_b_word == OFF_SDEL) ? f_sdel_d :
+                              (p_b_word == OFF_SEDEL) ? {32'd0, f_sdel_d[63:32]} :
+                              (p_b_word == OFF_SCNT_HI) ? {32'd0, f_scnt_d[63:32]} :
+                              (p_b_word == OFF_ILAT_HI) ? {32'd0, f_ilat_d[63:32]} :
+                              (p_b_word == OFF_PLAT_HI) ? {32'd0, f_plat_d[63:32]} :
+                              (p_b_word == OFF_PRE_HI) ? {32'd0, f_pre_d[63:32]} :
+                              {32'd0, f_ceil_d[63:32]};
   wire [31:0]      f_word_rst = (p_b_word == OFF_PRE) ? PRE_RST[31:0] :
-                                (p_b_word == OFF_CEIL) ? CEIL_RST[31:0] : 32'd0;
+                                (p_b_word == OFF_CEIL) ? CEIL_RST[31:0] :
+                                (p_b_word == OFF_PRE_HI) ? PRE_RST[63:32] :
+                                (p_b_word == OFF_CEIL_HI) ? CEIL_RST[63:32] :
+                                (p_b_word == OFF_CNT_HI && COUNT_W > 32) ? f_latv : 32'd0;
 
-  // the register the proof leaves out: COUNT_HI (its stage), not written on f
+  // the register the proof leaves out: COUNT_HI (its stage), not written on f; and offset 0x3F,
+  // which no register has (enc_qei sends the engine mapped offsets only) and the engine uses for
+  // a COUNT_HI latch it stores (none on f: see the assumption below)
   function left_out;
     input [5:0] off;
     begin
-      left_out = off == ENC_QEI_COUNT_HI[7:2];
+      left_out = off == ENC_QEI_COUNT_HI[7:2] || off == 6'h3F;
     end
   endfunction
 
@@ -686,6 +715,10 @@ module enc_qei_engine_formal #(
   always @(*) begin
     assume (f_ch < CHANNELS);
     if (req_valid && req_write && req_ch == f_ch) assume (!left_out(req_word));
+    // COUNT_W > 32: COUNT_LO is read on f only, so the engine's one COUNT_HI latch is always f's
+    // and never stored (that store, a COUNT_LO read of another channel, and the wait it makes
+    // are checked in simulation: test_engine's count_hi_save_wait)
+    if (COUNT_W > 32 && req_valid && !req_write && req_word == OFF_CNT) assume (req_ch == f_ch);
   end
 
   always @(posedge clk) begin
@@ -708,6 +741,7 @@ module enc_qei_engine_formal #(
       f_ilat <= 64'd0;
       f_plat <= 64'd0;
       f_chk  <= 1'b0;
+      f_lat  <= 1'b0;
       f_lk   <= 1'b0;
       f_pk   <= 1'b0;
       f_pre  <= PRE_RST;
@@ -776,8 +810,12 @@ module enc_qei_engine_formal #(
                 {OFF_CNT, 4'hF, (f_bcnt & ~lanes_of(p_b_wstrb)) | (p_b_wdata & lanes_of(p_b_wstrb))} :
                 {p_b_word, p_b_wstrb, p_b_wdata};
       end
-      if (f_bus && f_watched) begin
-        f_exp <= f_fresh ? f_word_rst : f_word_d[31:0];
+      if (f_bus && p_b_word == OFF_CNT && COUNT_W > 32) begin
+        f_lat  <= 1'b1;
+        f_latv <= f_fresh ? 32'd0 : f_sto_d[63:32];
+      end
+      if (f_bus && f_watched && (p_b_word != OFF_CNT_HI || f_lat || COUNT_W <= 32)) begin
+        f_exp <= (f_fresh || p_b_word == OFF_CNT_HI) ? f_word_rst : f_word_d[31:0];
         f_chk <= 1'b1;
       end else if (resp_valid) begin
         f_chk <= 1'b0;
@@ -858,6 +896,7 @@ module enc_qei_engine_formal #(
       if (f_wbv) begin
         if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
         assert (p_ip_pre == {f_lk && f_lx[41:36] == OFF_PRE_HI, f_lk && f_lx[41:36] == OFF_PRE});
+        assert (p_ip_hi == 2'd0);
         assert (p_ip_ceil == {f_lk && f_lx[41:36] == OFF_CEIL_HI, f_lk && f_lx[41:36] == OFF_CEIL});
         if (|p_ip_pre || |p_ip_ceil)
           assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
@@ -899,6 +938,20 @@ module enc_qei_engine_formal #(
       if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
                          p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
       if (f_chk && resp_valid) assert (resp_rdata == f_exp);
+      // W_HI of f: 0, its reset value (no COUNT_HI write on f, and no latch of f stored: f's
+      // first write-back writes it whole, no other write reaches it), as the visits read it
+      if (!f_fresh || (f_wbv && p_slot > W_HI)) assert (m_hi == 64'd0);
+      // COUNT_W > 32 (n_hi, o_hi and the latch are built then only): the visits' copies of W_HI;
+      // the engine's one COUNT_HI latch is f's (COUNT_LO is read on f only), and holds the high
+      // word of f's count as the last COUNT_LO read of f took it
+      if (COUNT_W <= 32) assert (!f_lat);  // (COUNT_HI reads 0)
+      if (COUNT_W > 32) begin
+        if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == 64'd0);
+        if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == 64'd0);
+        assert (p_lat_valid == f_lat);
+        if (p_b_st != B_IDLE && !p_b_wr && p_b_word == OFF_CNT) assert (p_b_ch == f_ch);
+        if (f_lat) assert (p_lat_ch == f_ch && p_lat_q == f_latv);
+      end
     end
   end
 `endif

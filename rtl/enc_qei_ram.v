@@ -49,7 +49,7 @@ module enc_qei_ram #(
   // A proof's view of F_PEEK words (formal/enc_qei_engine.sby, tasks data and data_ch3, read
   // this file with FORMAL defined and drive f_peek_addr after flatten): word i of f_peek is
   // mem[f_peek_addr[i]] now, no clock.
-  localparam integer F_PEEK = 11;
+  localparam integer F_PEEK = 12;
   wire [F_PEEK*AW-1:0] f_peek_addr;
   (* keep *) wire [F_PEEK*W-1:0] f_peek;
   genvar f_i;
