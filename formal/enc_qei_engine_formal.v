@@ -34,9 +34,9 @@
 //   - a write acts within the RDL's bounds (CAPS.ENGINE shared, (2)): P + 14 clocks after its
 //     answer, P + 18 after its request (a state write: P + 22, P + 26), and a read right after it
 //     is answered within P + 62 of its answer, P + 66 of its request (see that section).
-// With ENGINE_DATA (tasks data, data_ch3) also the data path of the count, its latches, PRESET,
-// CEILING and the snapshot's words, for one channel f (any, fixed; the bus writes any of its
-// registers but COUNT_HI): see the section at the end.
+// With ENGINE_DATA (tasks data, data_ch3, data_w40) also the data path of the count, its latches,
+// PRESET, CEILING, COUNT_HI and the snapshot's words, for one channel f (any, fixed; the bus
+// writes any of its registers): see the section at the end.
 `default_nettype none
 `ifdef ENGINE_DATA
 `include "enc_qei_lane_w.vh"
@@ -453,8 +453,8 @@ module enc_qei_engine_formal #(
   end
 
 `ifdef ENGINE_DATA
-  // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (tasks data, data_ch3)
-  // For one channel f (any, fixed; the bus reads any register of f and writes any but COUNT_HI),
+  // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (tasks data, data_ch3, data_w40)
+  // For one channel f (any, fixed; the bus reads and writes any register of f),
   // with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's
   // read and the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with PRESET and
   // CEILING as stored at the visit, and for the anchor A_LOAD the value of a COUNT_LO write taken
@@ -471,7 +471,11 @@ module enc_qei_engine_formal #(
   // read (the reset value until f's first write-back is complete). A COUNT_LO write carries its
   // bytes and, in those it leaves, COUNT_LO as read when it was written; a PRESET or CEILING write
   // (either half) carries its data and byte enables as written; no other write of f reaches
-  // these words.
+  // these words. The _HI halves' reads answer bits 63:32 of the words. COUNT_HI: a write of f
+  // (a state write) is taken at f's visit and written by f's write-back in slot 8 into the
+  // stage (W_HI[63:32]), its bytes merged; a COUNT_LO write loads {stage at the visit, value};
+  // with COUNT_W > 32, COUNT_LO read on f only (the assumption below), the engine's latch holds
+  // the high word of f's count at that read, and COUNT_HI answers it.
   // The snapshot's other words, the same way: from the record of f's read (its motion, last edge
   // and snapshot fields) with the timebase in the read's clock and the motion, last edge and last
   // snapshot as stored at the visit (W_MOT, W_EDGE, W_SBASE), through rtl/enc_qei_lane.vh's
@@ -589,6 +593,10 @@ module enc_qei_engine_formal #(
   reg  [31:0]      f_bcnt;   // COUNT_LO as read for a COUNT_LO write of f with some lanes off
   reg              f_lk;     // the read of the record took such a write (at its push)
   reg  [41:0]      f_lx;     // ... this one
+  reg              f_hk;     // f's visit took a COUNT_HI write (a state write, slot 21)
+  reg  [41:0]      f_hx;     // ... this one
+  reg  [31:0]      f_stage;  // COUNT_HI's stage as stored (W_HI[63:32]; f's write-back writes it)
+  reg  [31:0]      f_vstage; // ... at f's visit (a COUNT_LO write's high word)
   reg  [63:0]      f_pre, f_ceil;    // PRESET and CEILING as stored (f's write-back writes them)
   reg  [63:0]      f_vpre, f_vceil;  // ... at f's visit (the rebuild's)
   reg  [63:0]      f_pre_d, f_ceil_d;
@@ -604,7 +612,7 @@ module enc_qei_engine_formal #(
   reg  [63:0]      f_mot_d, f_edge_d, f_sbase_d, f_stim_d, f_sdel_d;
   reg  [63:0]      f_vmot, f_vedge, f_vsbase;
   wire             f_ld_ok = f_lk && f_lx[41:36] == OFF_CNT;  // a COUNT_LO write was loaded
-  wire [63:0]      f_ldb   = f_ld_ok ? {32'd0, f_lx[31:0]} & SZ : f_vpre;  // A_LOAD's value
+  wire [63:0]      f_ldb   = f_ld_ok ? {f_vstage, f_lx[31:0]} & SZ : f_vpre;  // A_LOAD's value
   wire [63:0]      f_new   = lane_rebuild(f_lo, f_anc, f_ldb, f_vceil, f_base, SZ);
   wire [63:0]      f_snew  = f_spend ? lane_rebuild(f_scap, f_sanc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
   wire [63:0]      f_inew  = f_ipend ? lane_rebuild(f_icap, f_ianc, f_vpre, f_vceil, f_base, SZ) : 64'd0;
@@ -658,26 +666,27 @@ module enc_qei_engine_formal #(
                                 (p_b_word == OFF_CEIL) ? CEIL_RST[31:0] :
                                 (p_b_word == OFF_PRE_HI) ? PRE_RST[63:32] :
                                 (p_b_word == OFF_CEIL_HI) ? CEIL_RST[63:32] :
-                                (p_b_word == OFF_CNT_HI && COUNT_W > 32) ? f_latv : 32'd0;
+                                (p_b_word == OFF_CNT_HI && f_lat) ? f_latv : 32'd0;
 
-  // the register the proof leaves out: COUNT_HI (its stage), not written on f; and offset 0x3F,
-  // which no register has (enc_qei sends the engine mapped offsets only) and the engine uses for
-  // a COUNT_HI latch it stores (none on f: see the assumption below)
+  // the offset the bus never writes: 0x3F, which no register has (enc_qei sends the engine mapped
+  // offsets only) and the engine uses for a COUNT_HI latch it stores (none on f: see the
+  // assumption below)
   function left_out;
     input [5:0] off;
     begin
-      left_out = off == ENC_QEI_COUNT_HI[7:2] || off == 6'h3F;
+      left_out = off == 6'h3F;
     end
   endfunction
 
-  // a write {offset, byte enables, data} of a watched word: COUNT_LO, PRESET, CEILING, with some
+  // a write {offset, byte enables, data} of a watched word: COUNT_LO, PRESET, CEILING, COUNT_HI
+  // (its stage, a state write), with some
   // byte enable (a write of none changes nothing)
   function watched_w;
     input [41:0] w;
     begin
       watched_w = |w[35:32] && (w[41:36] == OFF_CNT || w[41:36] == OFF_PRE ||
                                 w[41:36] == OFF_PRE_HI || w[41:36] == OFF_CEIL ||
-                                w[41:36] == OFF_CEIL_HI);
+                                w[41:36] == OFF_CEIL_HI || w[41:36] == OFF_CNT_HI);
     end
   endfunction
 
@@ -691,6 +700,16 @@ module enc_qei_engine_formal #(
       m = (w[41:36] == lo) ? {32'd0, lanes_of(w[35:32])} :
           (w[41:36] == lo + 6'd1) ? {lanes_of(w[35:32]), 32'd0} : 64'd0;
       wide_merge = ((c & ~m) | ({w[31:0], w[31:0]} & m)) & SZ;
+    end
+  endfunction
+
+  function [31:0] stage_merge;  // COUNT_HI's stage after the write w, kept to SZ's high word
+    input [31:0] c;
+    input [41:0] w;
+    reg   [31:0] m;
+    begin
+      m = lanes_of(w[35:32]);
+      stage_merge = ((c & ~m) | (w[31:0] & m)) & SZ[63:32];
     end
   endfunction
 
@@ -743,6 +762,8 @@ module enc_qei_engine_formal #(
       f_chk  <= 1'b0;
       f_lat  <= 1'b0;
       f_lk   <= 1'b0;
+      f_hk   <= 1'b0;
+      f_stage <= 32'd0;
       f_pk   <= 1'b0;
       f_pre  <= PRE_RST;
       f_ceil <= CEIL_RST;
@@ -784,6 +805,9 @@ module enc_qei_engine_formal #(
         f_tv    <= {{(32 - TS_W){1'b0}}, timebase};
       end
       if (f_calc) begin
+        f_hk     <= p_e_taken && f_pk;
+        f_hx     <= f_px;
+        f_vstage <= f_stage;
         f_base   <= f_sto;
         f_vpre   <= f_pre;
         f_vceil  <= f_ceil;
@@ -794,6 +818,8 @@ module enc_qei_engine_formal #(
       // PRESET and CEILING: f's write-back writes the write its visit took (slots 4, 5)
       if (f_wbv && p_slot == 5'd4 && f_lk) f_pre <= wide_merge(f_pre, f_lx, OFF_PRE);
       if (f_wbv && p_slot == 5'd5 && f_lk) f_ceil <= wide_merge(f_ceil, f_lx, OFF_CEIL);
+      // COUNT_HI's stage: f's write-back writes the COUNT_HI write its visit took (slot 8)
+      if (f_wbv && p_slot == W_HI && f_hk) f_stage <= stage_merge(f_stage, f_hx);
       if (f_wb) f_sto <= f_new;
       if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
       if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
@@ -814,7 +840,7 @@ module enc_qei_engine_formal #(
         f_lat  <= 1'b1;
         f_latv <= f_fresh ? 32'd0 : f_sto_d[63:32];
       end
-      if (f_bus && f_watched && (p_b_word != OFF_CNT_HI || f_lat || COUNT_W <= 32)) begin
+      if (f_bus && f_watched) begin
         f_exp <= (f_fresh || p_b_word == OFF_CNT_HI) ? f_word_rst : f_word_d[31:0];
         f_chk <= 1'b1;
       end else if (resp_valid) begin
@@ -860,12 +886,15 @@ module enc_qei_engine_formal #(
           !(&p_b_wstrb)) assert (p_b_cnt == f_bcnt);
       if (p_pend_we && p_pend_wch == f_ch) assert (slot_ok(p_pend_wd, f_pk, f_px));
       if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pk, f_px));
-      if (|(p_pend & p_pend_st & (1 << f_ch))) assert (!f_pk);  // (a state write: none of them)
+      // (a state write: none of them but COUNT_HI)
+      if (|((p_pend | p_busy) & p_pend_st & (1 << f_ch))) assert (!f_pk || f_px[41:36] == OFF_CNT_HI);
+      if (|((p_pend | p_busy) & ~p_pend_st & (1 << f_ch))) assert (!f_pk || f_px[41:36] != OFF_CNT_HI);
       if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pk, f_px));
       if (p_cp == f_ch) begin
         assert (p_p_taken ? slot_ok(p_p_pend, f_lk, f_lx) : !f_lk);
-        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk);
-        if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, 1'b0, 42'd0));
+        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk || f_px[41:36] == OFF_CNT_HI);
+        if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, f_pk, f_px));
+        if (p_p_taken && f_lk) assert (f_lx[41:36] != OFF_CNT_HI);
       end
       // the count word of f: written whole in slot 0 of each of f's write-backs (always pending)
       stored_word(a_cnt, 5'd0, 1'b1, f_new, m_cnt, f_sto, p_n_cnt, 1'b1);
@@ -896,7 +925,10 @@ module enc_qei_engine_formal #(
       if (f_wbv) begin
         if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
         assert (p_ip_pre == {f_lk && f_lx[41:36] == OFF_PRE_HI, f_lk && f_lx[41:36] == OFF_PRE});
-        assert (p_ip_hi == 2'd0);
+        assert (p_ip_hi == {f_hk && f_hx[41:36] == OFF_CNT_HI, 1'b0});
+        if (f_hk) assert (f_hx[41:36] == OFF_CNT_HI && !f_lk);
+        if (|p_ip_hi) assert (p_ip_data == f_hx[31:0] && p_ip_lanes == lanes_of(f_hx[35:32]));
+        assert (f_stage == ((p_slot > W_HI && f_hk) ? stage_merge(f_vstage, f_hx) : f_vstage));
         assert (p_ip_ceil == {f_lk && f_lx[41:36] == OFF_CEIL_HI, f_lk && f_lx[41:36] == OFF_CEIL});
         if (|p_ip_pre || |p_ip_ceil)
           assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
@@ -938,16 +970,19 @@ module enc_qei_engine_formal #(
       if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
                          p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
       if (f_chk && resp_valid) assert (resp_rdata == f_exp);
-      // W_HI of f: 0, its reset value (no COUNT_HI write on f, and no latch of f stored: f's
-      // first write-back writes it whole, no other write reaches it), as the visits read it
-      if (!f_fresh || (f_wbv && p_slot > W_HI)) assert (m_hi == 64'd0);
+      // W_HI of f: the stage as stored, and 0 for the stored latch (no latch of f is stored: see
+      // the assumption); 0 before f's first write-back (which writes it whole); as the visits
+      // read it
+      assert ((f_stage & ~SZ[63:32]) == 32'd0);
+      if (!f_fresh || (f_wbv && p_slot > W_HI)) assert (m_hi == {f_stage, 32'd0});
+      else assert (f_stage == 32'd0);
       // COUNT_W > 32 (n_hi, o_hi and the latch are built then only): the visits' copies of W_HI;
       // the engine's one COUNT_HI latch is f's (COUNT_LO is read on f only), and holds the high
       // word of f's count as the last COUNT_LO read of f took it
       if (COUNT_W <= 32) assert (!f_lat);  // (COUNT_HI reads 0)
       if (COUNT_W > 32) begin
-        if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == 64'd0);
-        if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == 64'd0);
+        if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == {f_stage, 32'd0});
+        if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == {f_stage, 32'd0});
         assert (p_lat_valid == f_lat);
         if (p_b_st != B_IDLE && !p_b_wr && p_b_word == OFF_CNT) assert (p_b_ch == f_ch);
         if (f_lat) assert (p_lat_ch == f_ch && p_lat_q == f_latv);
