@@ -39,7 +39,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 from enctools.qei.bus import WbRaw, signed
 from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
                               ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT,
-                              ENGINE_SAVE_WAIT, ENGINE_STATE_WAIT, ENGINE_WAIT, PER_CHANNEL_ANSWER, PROFILES, begin,
+                              ENGINE_SAVE_READ, ENGINE_SAVE_WAIT, ENGINE_SAVE_WAIT_REQ, ENGINE_STATE_WAIT, ENGINE_WAIT,
+                              PER_CHANNEL_ANSWER, PROFILES, begin,
                               build_name,
                               channel_envs, engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
@@ -503,9 +504,11 @@ async def read_after_write_wait(dut):
 async def count_hi_save_wait(dut):
     """COUNT_W > 32 with two channels or more: a COUNT_LO read of channel k after one of channel j
     stores j's COUNT_HI latch (the high word of j's count at that read) in the engine's memory;
-    COUNT_HI of j reads that word afterwards, and a read or write of j requested right after the
-    read of k is answered at most P + ENGINE_SAVE_WAIT clocks after that read's request (the RDL),
-    at every phase of the visits, and at some phase within 2 clocks of that."""
+    COUNT_HI of j reads that word afterwards. A read or write of j requested right after the read
+    of k is answered at most P + ENGINE_SAVE_WAIT clocks after that read's answer, and
+    P + ENGINE_SAVE_WAIT_REQ after its request when it did not wait; when j had a write not yet
+    stored, the read of k waits for it: answered at most P + ENGINE_SAVE_READ after that write's
+    answer (the RDL). At every phase of the visits; each bound within 2 clocks at some phase."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     if not env.engine or env.count_w <= 32 or n < 2:
@@ -513,8 +516,8 @@ async def count_hi_save_wait(dut):
         return
     raw = WbRaw(dut)
     p = engine_period(n)
-    worst = worst_ans = 0
-    for rel, write in [(rel, w) for rel in range(p) for w in (False, True)]:
+    worst = {"answer": 0, "request": 0, "k read": 0}
+    for rel, case in [(rel, c) for rel in range(p) for c in ("read", "write", "j written")]:
         j = rng.randrange(n)
         k = rng.choice([c for c in range(n) if c != j])
         hi = rng.getrandbits(32) & ((1 << (env.count_w - 32)) - 1)
@@ -523,27 +526,40 @@ async def count_hi_save_wait(dut):
         await ClockCycles(dut.clk, p + ENGINE_WAIT)
         await raw.access(addr("COUNT_LO", j))  # COUNT_HI's latch: j's
         await at_phase(dut, p, rel)
+        if case == "j written":  # j has a write not stored yet: the read of k waits for it
+            await raw.access(addr("PRESET_LO", j), rng.getrandbits(32))
+            w_done = int(raw.tb.value)
         r, _, _ = await raw.access(addr("COUNT_LO", k))  # ... stored, the latch k's
         r_done = int(raw.tb.value)
-        dut._log.debug("k read answered %d", r_done - r)
-        if write:
+        if case == "write":
             await raw.access(addr("IRQ_EN", j), 0)
         else:
             await raw.access(addr("PRESET_LO", j))
         done = int(raw.tb.value)
-        assert done - r <= p + ENGINE_SAVE_WAIT, \
-            f"channel {j}: {'a write' if write else 'a read'} right after a COUNT_LO read of channel " \
-            f"{k} answered {done - r} clocks after that read's request (bound P + {ENGINE_SAVE_WAIT}, P {p})"
-        worst = max(worst, done - r - p)
-        worst_ans = max(worst_ans, done - r_done - p)
+        what = f"channel {j}: an access ({case}) right after a COUNT_LO read of channel {k} answered"
+        assert done - r_done <= p + ENGINE_SAVE_WAIT, \
+            f"{what} {done - r_done} clocks after that read's answer (bound P + {ENGINE_SAVE_WAIT}, P {p})"
+        worst["answer"] = max(worst["answer"], done - r_done - p)
+        if case == "j written":
+            assert r_done - w_done <= p + ENGINE_SAVE_READ, \
+                f"channel {k}: a COUNT_LO read after a write of channel {j} (whose latch it stores) " \
+                f"answered {r_done - w_done} clocks after that write's answer (bound P + {ENGINE_SAVE_READ})"
+            worst["k read"] = max(worst["k read"], r_done - w_done - p)
+        else:
+            assert done - r <= p + ENGINE_SAVE_WAIT_REQ, \
+                f"{what} {done - r} clocks after that read's request (bound P + {ENGINE_SAVE_WAIT_REQ}, P {p})"
+            worst["request"] = max(worst["request"], done - r - p)
         got = (await raw.access(addr("COUNT_HI", j)))[1]
         assert got == hi, f"channel {j}: COUNT_HI {got:#x} after its latch was stored, {hi:#x} written"
-    dut._log.info("an access of channel j right after a COUNT_LO read of another channel answered at "
-                  "worst P + %d clocks after that read's request, P + %d after its answer (bound P + %d, P %d)", worst,
-                  worst_ans, ENGINE_SAVE_WAIT, p)
-    assert worst >= ENGINE_SAVE_WAIT - 2, \
-        f"the worst access after a latch was stored was answered at P + {worst}: the RDL's " \
-        f"P + {ENGINE_SAVE_WAIT} is loose"
+    dut._log.info("an access of channel j right after a COUNT_LO read that stored j's latch: answered "
+                  "at worst P + %d after that read's answer (bound P + %d), P + %d after its request "
+                  "(bound P + %d); that read, after a write of j: P + %d after the write's answer "
+                  "(bound P + %d); P %d", worst["answer"], ENGINE_SAVE_WAIT, worst["request"],
+                  ENGINE_SAVE_WAIT_REQ, worst["k read"], ENGINE_SAVE_READ, p)
+    for key, bound in (("answer", ENGINE_SAVE_WAIT), ("request", ENGINE_SAVE_WAIT_REQ),
+                       ("k read", ENGINE_SAVE_READ)):
+        assert worst[key] >= bound - 2, \
+            f"the worst case ({key}) was P + {worst[key]}: the RDL's P + {bound} is loose"
 
 
 @cocotb_test()
@@ -961,7 +977,9 @@ def test_rdl_says_the_bounds():
         "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
         "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
         "ENGINE_PART_WAIT": r"and P \+ (\d+) after a COUNT_LO write with some but not all byte enables set",
-        "ENGINE_SAVE_WAIT": r"answered at most P \+ (\d+) clocks after the COUNT_LO read's request",
+        "ENGINE_SAVE_WAIT": r"answered at most P \+ (\d+) clocks after the COUNT_LO read's answer",
+        "ENGINE_SAVE_WAIT_REQ": r"\(P \+ (\d+) after its request when it did not wait\)",
+        "ENGINE_SAVE_READ": r"then it is answered at most P \+ (\d+) clocks after that write's answer",
         "ENGINE_ANSWER": r"a write of a channel register is answered (\d+) clocks after its request",
         "ENGINE_READ_ANSWER": r"a read (\d+) clocks after its request",
         "ENGINE_PART_ANSWER": r"a COUNT_LO write with some but not all byte enables set (\d+)",

@@ -29,8 +29,9 @@
 // stored: one right after a write is answered at most P + 66 clocks after the write's request
 // (P + 68 after a COUNT_LO write with some byte lanes off, which the driver does not make).
 // With COUNT_W > 32, a COUNT_LO read of another channel than the last COUNT_LO read's stores that
-// channel's COUNT_HI latch, and an access of that channel requested right after waits for the
-// store: at most P + 29 clocks after that read's request.
+// channel's COUNT_HI latch (after that channel's write not stored yet: at most P + 63 clocks after
+// that write's answer), and an access of that channel requested right after waits for the store:
+// at most P + 23 clocks after that read's answer.
 // The server holds every access to that bound, counted from the last write of the same 0x100-byte
 // page (a channel); for a write that itself waited for an earlier one, from its answer less 6
 // clocks, as if it had been requested then and not waited (the RDL states the bound for a write
@@ -80,13 +81,16 @@ constexpr int kPages = 64;  // 0x100-byte pages of the address space (a channel'
 uint64_t last_write[kPages];  // each page's last write: its request, or for a write that waited
                               // its answer less answer_bound
 // COUNT_W > 32 on the shared engine with two channels or more: a COUNT_LO read of another channel
-// than the last COUNT_LO read's stores that channel's COUNT_HI latch, and an access of that
-// channel right after waits for the store: answered at most P + 29 clocks after the read's request
+// than the last COUNT_LO read's stores that channel's COUNT_HI latch (waiting for that channel's
+// write not stored yet: answered at most P + 63 clocks after that write's answer), and an access
+// of that channel right after waits for the store: answered at most P + 23 clocks after the
+// read's answer
 bool save_rule;
-int save_bound;               // P + 29
+int save_bound;               // P + 23
+int save_read_bound;          // P + 63, from the write's request: P + 67
 int latch_page = -1;          // the channel (page) whose COUNT_HI latch the engine holds
 bool saved[kPages];           // a latch store was made for the page ...
-uint64_t last_save[kPages];   // ... by the COUNT_LO read requested then
+uint64_t last_save[kPages];   // ... by the COUNT_LO read answered then
 constexpr uint32_t kCountLo = 0x10;  // COUNT_LO's offset in a channel's page
 
 void tick() {
@@ -112,6 +116,7 @@ void drive_inputs() {
 // One Wishbone access; returns the status (0 ack, 1 err) and the read data in *data.
 uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     const uint64_t request = clocks;
+    uint64_t answered = request;
     top->wb_adr_i = addr;
     top->wb_dat_i = *data;
     top->wb_sel_i = sel;
@@ -133,8 +138,14 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
             const uint64_t since_write = request + i - last_write[page];
             const bool after_save = saved[page] &&
                 request + i - last_save[page] <= static_cast<uint64_t>(save_bound);
+            // (a COUNT_LO read that stores another channel's latch waits for that one's write)
+            const bool stores = save_rule && !we && (addr & 0xff) == kCountLo &&
+                latch_page >= 0 && latch_page != page;
+            const bool after_other = stores &&
+                request + i - last_write[latch_page] <= static_cast<uint64_t>(save_read_bound);
             const bool late = i > answer_bound &&
-                since_write > static_cast<uint64_t>(after_write_bound) && !after_save;
+                since_write > static_cast<uint64_t>(after_write_bound) && !after_save && !after_other;
+            answered = request + i;
             if (late && late_answers++ < 8)
                 fprintf(stderr, "enc_qei_server: late answer: a %s of 0x%03x answered %d clocks "
                         "after its request (clock %llu), %llu after a %s of 0x%03x\n",
@@ -158,7 +169,7 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     if (save_rule && !we && (addr & 0xff) == kCountLo && page < channels) {
         if (latch_page >= 0 && latch_page != page) {
             saved[latch_page] = true;
-            last_save[latch_page] = request;
+            last_save[latch_page] = answered;
         }
         latch_page = page;
     }
@@ -248,7 +259,8 @@ int main(int argc, char **argv) {
     if (engine)
         answer_bound = 6, after_write_bound = p + 66;
     save_rule = engine && (caps & 0xff) > 32 && channels > 1;  // CAPS.COUNT_W
-    save_bound = p + 29;
+    save_bound = p + 23;
+    save_read_bound = p + 67;
     for (int k = 0; k < channels; k++)
         enc_stim_init(&stim[k], static_cast<unsigned>(k));
     drive_inputs();
