@@ -33,7 +33,10 @@
 //     minus completed writes is pend | busy);
 //   - a write acts within the RDL's bounds (CAPS.ENGINE shared, (2)): P + 14 clocks after its
 //     answer, P + 18 after its request (a state write: P + 22, P + 26), and a read right after it
-//     is answered within P + 62 of its answer, P + 66 of its request (see that section).
+//     is answered within P + 62 of its answer, P + 66 of its request (see that section);
+//   - with COUNT_W > 32 (task prove_w40), COUNT_HI's latch: a COUNT_LO read of another channel
+//     stores it first, as a state write of that channel, and the waits that makes stay within
+//     the RDL's bounds (see that section).
 // With ENGINE_DATA (tasks data, data_ch3, data_w40) also the data path of the count, its latches,
 // PRESET, CEILING, COUNT_HI and the snapshot's words, for one channel f (any, fixed; the bus
 // writes any of its registers): see the section at the end.
@@ -148,6 +151,8 @@ module enc_qei_engine_formal #(
   (* keep *) wire [CHANNELS-1:0] p_spend;     // eng.snap_pend: a lane's capture waits (free)
   (* keep *) wire                p_lsnap0;    // eng.g_lane[0].u_lane.gsnap: lane 0's input
   (* keep *) wire                p_lsnap1;    // eng.g_lane[1].u_lane.gsnap: lane 1's input
+  (* keep *) wire                p_lat_valid; // eng.lat_valid_q: COUNT_HI's latch is held (COUNT_W
+  (* keep *) wire [3:0]          p_lat_ch;    // eng.lat_ch_q: ... of this channel  > 32 only: w40)
 
   localparam [2:0] B_IDLE = 3'd0, B_WAIT = 3'd1, B_RD1 = 3'd2, B_RD2 = 3'd3, B_POST = 3'd4,
                    B_DONE = 3'd5;
@@ -255,8 +260,49 @@ module enc_qei_engine_formal #(
       assert (p_b_st <= B_DONE && (p_b_st == B_IDLE || p_b_ch < CHANNELS));
       if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST)
         assert (!(|((p_pend | p_busy) & (1 << p_b_ch))));
-      assert (p_pend_set == ((p_b_st == B_DONE && p_pend_we) ? (1 << p_b_ch) : 0));
-      if (p_pend_we) assert (p_b_st == B_DONE && p_pend_wch == p_b_ch);
+      assert (p_pend_set == (f_save1 ? (1 << f_save_ch) :
+                             (p_b_st == B_DONE && p_pend_we) ? (1 << p_b_ch) : 0));
+      if (p_pend_we) assert (f_save1 ? (p_b_st == B_WAIT && p_pend_wch == f_save_ch) :
+                                       (p_b_st == B_DONE && p_pend_wch == p_b_ch));
+      if (f_save1) assert (p_pend_we && COUNT_W > 32 && !p_lat_valid && f_save_ch != p_b_ch);
+      if (COUNT_W > 32 && p_lat_valid) assert (p_lat_ch < CHANNELS &&
+                                               !(f_wsave[p_lat_ch] && (p_pend[p_lat_ch] || p_busy[p_lat_ch])));
+      if (f_lw_v && !f_after[f_lw]) assert (f_lw < CHANNELS && f_wage[f_lw] == f_lwage);
+      // (the last request: a write, posted once; a read that stored a latch, posted once)
+      if (f_pw && !f_out_q) assert (f_cur[f_pch]);
+      if (f_pw) assert (f_pch < CHANNELS &&
+                        f_cur == ((p_b_st == B_IDLE) ? (1 << f_pch) : {CHANNELS{1'b0}}));
+      if (!f_pw) assert (f_cur == (f_psv ? (1 << f_psv_ch) : {CHANNELS{1'b0}}));
+      if (f_out_q && p_b_st != B_IDLE) assert (p_b_wr == f_pw && p_b_ch == f_pch);
+      if (f_pw && f_cur[f_pch]) assert (f_lw_v && f_lw == f_pch && !f_after[f_pch] && !f_psv);
+      if (f_psv) assert (!f_pw && f_cur[f_psv_ch] && f_wsave[f_psv_ch] && f_after[f_psv_ch] &&
+                         f_psv_ch < CHANNELS);
+      // (the store's age: 3 at least at the answer to the read that made it, which is of another
+      // channel)
+      assert ((f_after & ~f_wsave) == {CHANNELS{1'b0}});
+      // (a COUNT_LO read holds its channel's latch from its take on)
+      if (COUNT_W > 32 && !p_b_wr && p_b_word == OFF_CNT_LO &&
+          (p_b_st == B_DONE || (p_b_st == B_RD2 && f_took1) || (p_b_st == B_IDLE && f_out_q)))
+        assert (p_lat_valid && p_lat_ch == p_b_ch);
+      if (f_psv) assert (!p_b_wr && p_b_word == OFF_CNT_LO && p_b_ch == f_pch);
+      if (f_psv && !f_out_q) assert (p_lat_valid && p_lat_ch == f_pch && f_pch != f_psv_ch &&
+                                     !(p_pend[f_pch] || p_busy[f_pch]));
+      if (COUNT_W > 32 && f_rdw && f_rdw_sv && p_lat_valid && p_lat_ch != f_rdw_ch)
+        assert (!(p_pend[p_lat_ch] || p_busy[p_lat_ch]));
+      if (f_psv && f_out_q) assert (f_psv_ch != p_b_ch && {1'b0, f_wage[f_psv_ch]} + {1'b0, f_rem} >= 9'd3);
+      if (f_psv && !f_out_q) assert ({1'b0, f_wage[f_psv_ch]} >= {1'b0, f_ka} + 9'd3);
+      // (COUNT_W <= 32: no latch, nothing stored; p_lat_valid and p_lat_ch are not connected)
+      if (COUNT_W <= 32) assert (!f_save1 && !f_psv && !f_rdw_sv && !f_lwt && f_wsave == 0 && f_after == 0);
+      // the order of the writes in flight: one posted before the last bus write's post is older
+      // than it by 4 clocks at least (requests come one at a time); during a request, every write
+      // in flight posted before it is older than the request
+      for (k = 0; k < CHANNELS; k = k + 1) begin
+        if (f_lw_v && k != f_lw && (p_pend[k] || p_busy[k]) && !f_after[k])
+          assert ({1'b0, f_wage[k]} >= {1'b0, f_lwage} + 9'd4);
+        if (f_out_q && (p_pend[k] || p_busy[k]) && !f_cur[k])
+          assert (f_wage[k] >= {5'd0, f_rq_age} + 8'd1);
+        if (f_wsave[k] && (p_pend[k] || p_busy[k])) assert (p_pend_st[k] && !f_nowait[k]);
+      end
       // port a: a read whose data is used (slots 1 .. 22) is not of the word written in its clock
       if (p_slot >= 1 && p_slot <= V - 2) assert (!(p_we && p_waddr == p_raddr_a));
       // port b: the data the bus takes (B_RD1's, or B_RD2's after a clash) was not read in a
@@ -300,6 +346,11 @@ module enc_qei_engine_formal #(
   // a read requested while a write of its channel is not stored yet: it waits for it (the
   // bounds: below)
   reg                 f_rdw;      // such a read is in flight
+  reg                 f_rdw_sv;   // ... right after a COUNT_LO read that stored its channel's latch
+  wire [7:0]          f_rem;      // clocks from now to the bus's answer, by its state, at most
+  reg                 f_lwt;      // COUNT_W > 32: the read waited for the write of the channel
+  reg  [3:0]          f_lwt_ch;   // ... whose latch it stores
+  reg  [7:0]          f_lwt_age;  // ... that write's clocks since its answer
   reg  [3:0]          f_rdw_ch;   // ... of this channel
   reg  [7:0]          f_stake [0:CHANNELS-1];  // a taken write's clocks since its take
 
@@ -334,14 +385,91 @@ module enc_qei_engine_formal #(
     end
   end
 
+  // COUNT_W > 32: a COUNT_LO read of another channel than the latch's stores the latch (posts a
+  // state write into that channel's slot, in B_WAIT, once that channel has no write unstored)
+  wire                f_save_now = (COUNT_W > 32) && p_b_st == B_WAIT && !p_b_wr &&
+                                   p_b_word == OFF_CNT_LO && p_lat_valid && p_lat_ch != p_b_ch;
+  wire                f_save_go  = f_save_now && !(|((p_pend | p_busy) & (1 << p_lat_ch)));
+  assign f_rem = (p_b_st == B_WAIT) ? (f_save_now ? 8'd6 : 8'd5) : (p_b_st == B_RD1) ? 8'd4 :
+                 (p_b_st == B_RD2) ? 8'd3 : (p_b_st == B_DONE) ? 8'd2 : 8'd1;
+  reg                 f_save1;    // the latch was stored in the clock before (its post: now)
+  reg  [3:0]          f_save_ch;  // ... of this channel
+  reg  [CHANNELS-1:0] f_wsave;    // the channel's write in flight is such a store
+  reg  [CHANNELS-1:0] f_after;    // ... was posted after the last bus write's post
+  reg  [CHANNELS-1:0] f_cur;      // ... was posted during the request under way (or the last)
+  reg                 f_lw_v;     // a bus write was posted (since rst) ...
+  reg  [3:0]          f_lw;       // ... the last one of this channel
+  reg  [7:0]          f_lwage;    // ... its clocks since its answer (as f_wage)
+  reg                 f_pw;       // the last request was a write (of f_pch)
+  reg  [3:0]          f_pch;
+  reg                 f_psv;      // a latch was stored during the last request (f_psv_ch's)
+  reg  [3:0]          f_psv_ch;
+  reg  [7:0]          f_ka;       // clocks since the last answer (to 252: a store's age less 3)
+
   always @(posedge clk) begin
     if (rst) begin
-      f_rdw <= 1'b0;
+      f_save1 <= 1'b0;
+      f_lw_v  <= 1'b0;
+      f_pw    <= 1'b0;
+      f_psv   <= 1'b0;
+    end else begin
+      f_save1   <= f_save_go;
+      f_save_ch <= p_lat_ch;
+      f_ka      <= resp_valid ? 8'd0 : (f_ka >= 8'd252) ? 8'd252 : f_ka + 8'd1;
+      if (req_valid) begin
+        f_pw  <= req_write;
+        f_pch <= req_ch;
+        f_psv <= 1'b0;
+      end else if (f_save1) begin
+        f_psv    <= 1'b1;
+        f_psv_ch <= f_save_ch;
+      end
+      if (|p_pend_set && !f_save1) begin
+        f_lw_v  <= 1'b1;
+        f_lw    <= p_b_ch;
+        f_lwage <= 8'd0;
+      end else begin
+        f_lwage <= (f_lwage == 8'hFF) ? f_lwage : f_lwage + 8'd1;
+      end
+    end
+    for (k = 0; k < CHANNELS; k = k + 1) begin
+      if (rst || req_valid) f_cur[k] <= 1'b0;
+      else if (p_pend_set[k]) f_cur[k] <= 1'b1;
+      if (rst) begin
+        f_wsave[k] <= 1'b0;
+        f_after[k] <= 1'b0;
+      end else if (p_pend_set[k]) begin
+        f_wsave[k] <= f_save1;
+        f_after[k] <= f_save1;
+      end else if (|p_pend_set && !f_save1) begin
+        f_after[k] <= 1'b0;
+      end
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_rdw    <= 1'b0;
+      f_rdw_sv <= 1'b0;
+      f_lwt    <= 1'b0;
     end else if (req_valid) begin
-      f_rdw    <= !req_write && (f_owed[req_ch] != 2'd0);
+      // (COUNT_W > 32: a read right after a write of its channel, or right after a COUNT_LO read
+      // that stored its channel's latch, as the RDL states them; with COUNT_W <= 32 any read
+      // that finds a write of its channel unstored)
+      f_rdw    <= !req_write && (f_owed[req_ch] != 2'd0) &&
+                  (COUNT_W <= 32 || (f_pw && f_pch == req_ch) || (f_psv && f_psv_ch == req_ch));
+      f_rdw_sv <= COUNT_W > 32 && !(f_pw && f_pch == req_ch) && f_psv && f_psv_ch == req_ch;
       f_rdw_ch <= req_ch;
-    end else if (resp_valid) begin
-      f_rdw <= 1'b0;
+      f_lwt    <= 1'b0;
+    end else begin
+      if (resp_valid) f_rdw <= 1'b0;
+      if (f_save_now && (|((p_pend | p_busy) & (1 << p_lat_ch)))) begin
+        f_lwt     <= 1'b1;
+        f_lwt_ch  <= p_lat_ch;
+        f_lwt_age <= f_wage[p_lat_ch] + 8'd1;
+      end else begin
+        f_lwt_age <= (f_lwt_age == 8'hFF) ? f_lwt_age : f_lwt_age + 8'd1;
+      end
     end
   end
 
@@ -366,9 +494,9 @@ module enc_qei_engine_formal #(
       end else if (p_pend_set[k]) begin
         f_wlive[k]  <= 1'b1;
         f_wage[k]   <= 8'd0;
-        f_wrq[k]    <= (f_rq_age >= 3'd5) ? 3'd7 : f_rq_age + 3'd2;  // (the answer: a clock on)
-        f_wcnt[k]   <= p_b_wr && p_b_word == OFF_CNT_LO;
-        f_nowait[k] <= f_wc == 2'd1;
+        f_wrq[k]    <= (f_save1 || f_rq_age >= 3'd5) ? 3'd7 : f_rq_age + 3'd2;  // (the answer: a clock on)
+        f_wcnt[k]   <= !f_save1 && p_b_wr && p_b_word == OFF_CNT_LO;
+        f_nowait[k] <= !f_save1 && f_wc == 2'd1;
       end else begin
         if (f_act[k]) f_wlive[k] <= 1'b0;
         f_wage[k] <= (f_wage[k] == 8'hFF) ? f_wage[k] : f_wage[k] + 8'd1;
@@ -382,6 +510,7 @@ module enc_qei_engine_formal #(
       // only a COUNT_LO write with some byte lanes off reads before it posts)
       assert (p_b_st == B_IDLE ? (!f_out_q || resp_valid) : f_out_q);
       if (p_b_st == B_WAIT && f_wc == 2'd0) assert (f_rq_age == 3'd0);
+      assert (f_wc <= 2'd2 && (f_wc == 2'd0 || f_rq_age >= {1'b0, f_wc}));
       if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST || p_b_st == B_DONE)
         assert (f_wc != 2'd0);
       if ((p_b_st == B_RD1 || p_b_st == B_RD2) && p_b_wr) assert (p_b_word == OFF_CNT_LO);
@@ -438,16 +567,50 @@ module enc_qei_engine_formal #(
         assert (f_rdw_ch < CHANNELS && (p_b_st == B_IDLE ? resp_valid :
                                          (p_b_ch == f_rdw_ch && !p_b_wr && p_b_st != B_POST)));
         if (p_b_st != B_WAIT) assert (!(|((p_pend | p_busy) & (1 << f_rdw_ch))));
-        if (!(|((p_pend | p_busy) & (1 << f_rdw_ch))))
-          assert (f_wage[f_rdw_ch] + ((p_b_st == B_WAIT) ? 5 : (p_b_st == B_RD1) ? 4 :
-                                      (p_b_st == B_RD2) ? 3 : (p_b_st == B_DONE) ? 2 : 1)
-                  <= (p_pend_st[f_rdw_ch] ? P + 27 : P + 63));
+        assert (f_wage[f_rdw_ch] <= P + 58 + {5'd0, f_rq_age} || f_lwt);
+        if (f_lwt) assert (f_lwt_age <= 8'd230);
+        // (the clocks to its answer, by state; a COUNT_LO read that still stores a latch: one
+        // more. With COUNT_W > 32 it may come as the write is stored and take its own clocks, 6
+        // with a latch to store: one more than the bounds below)
+        if (!(|((p_pend | p_busy) & (1 << f_rdw_ch))) &&
+            !(f_save_now && (|((p_pend | p_busy) & (1 << p_lat_ch)))))
+          assert ((f_wage[f_rdw_ch] + f_rem <= (p_pend_st[f_rdw_ch] ? P + 27 : P + 63)) ||
+                  (COUNT_W > 32 && {5'd0, f_rq_age} + f_rem <= 8'd6) ||
+                  (f_lwt && !f_rdw_sv && f_lwt_age + f_rem <= P + 64));
+        // (waiting for the write of the channel whose latch it stores: that write is older, and
+        // the read is answered within P + 63 of its answer)
+        if (f_lwt) assert (!f_rdw_sv && f_lwt_ch != f_rdw_ch && f_lwt_ch < CHANNELS &&
+                           {1'b0, f_lwt_age} >= {1'b0, f_wage[f_rdw_ch]} + 9'd4 &&
+                           {1'b0, f_lwt_age} <= {1'b0, f_wage[f_rdw_ch]} + P + 58 &&
+                           !p_b_wr && p_b_word == OFF_CNT_LO);
+        if (COUNT_W > 32 && f_lwt && !f_save_now &&
+            (p_b_st == B_WAIT || p_b_st == B_RD1 || (p_b_st == B_RD2 && !f_took1)))
+          assert (!p_lat_valid);
+        if (f_lwt) assert (f_rq_age >= 3'd1 && (p_b_st == B_WAIT || (f_wc == 2'd2 && f_rq_age >= 3'd3)));
+        if (f_lwt && (|((p_pend | p_busy) & (1 << f_lwt_ch))) && !(f_wsave[f_lwt_ch] && f_cur[f_lwt_ch]))
+          assert (p_b_st == B_WAIT && f_save_now && p_lat_ch == f_lwt_ch &&
+                  f_wage[f_lwt_ch] == f_lwt_age);
+        if (f_rdw_sv) assert ({1'b0, f_wage[f_rdw_ch]} >= {1'b0, f_ka} + 9'd3 &&
+                              f_wage[f_rdw_ch] <= P + 22 + {5'd0, f_rq_age});
+        assert (p_b_st == B_RD1 ? f_rq_age >= 3'd1 : p_b_st == B_RD2 ? f_rq_age >= 3'd2 :
+                p_b_st == B_DONE ? f_rq_age >= 3'd3 : 1'b1);
+        // (COUNT_W > 32: it may store another channel's latch first, waiting for that channel's
+        // write, which is older: the read came right after its own channel's write)
+        if (f_save_now && (|((p_pend | p_busy) & (1 << p_lat_ch))))
+          assert (!f_rdw_sv && f_lw_v && f_lw == f_rdw_ch && !f_after[p_lat_ch] &&
+                  !f_after[f_rdw_ch]);
+        if (f_rdw_sv) assert (f_wsave[f_rdw_ch] && p_pend_st[f_rdw_ch]);
       end
-      if (f_rdw && resp_valid) begin
-        assert (f_wage[f_rdw_ch] <= (p_pend_st[f_rdw_ch] ? P + 26 : P + 62));
+      // (after a store of its channel's latch: at most P + 23 clocks after the answer to the
+      // COUNT_LO read that stored it, or 6 after its own request)
+      if (f_rdw && f_rdw_sv && resp_valid) assert (f_ka <= P + 23 || f_rq_age <= 3'd5);
+      if (f_rdw && !f_rdw_sv && resp_valid && !(COUNT_W > 32 && f_rq_age <= 3'd5)) begin
+        assert (f_wage[f_rdw_ch] <= (p_pend_st[f_rdw_ch] ? P + 26 : P + 62) ||
+                (f_lwt && f_lwt_age <= P + 63));
         if (f_nowait[f_rdw_ch])
           assert ({5'd0, f_wrq[f_rdw_ch]} + f_wage[f_rdw_ch] <=
-                  (p_pend_st[f_rdw_ch] ? P + 30 : (f_wrq[f_rdw_ch] == 3'd6) ? P + 68 : P + 66));
+                  (p_pend_st[f_rdw_ch] ? P + 30 : (f_wrq[f_rdw_ch] == 3'd6) ? P + 68 : P + 66) ||
+                  (f_lwt && f_lwt_age <= P + 63));
       end
     end
   end
@@ -564,9 +727,7 @@ module enc_qei_engine_formal #(
   (* keep *) wire [1:0]          p_ip_hi;    // eng.ip_hi_q: the write-back's COUNT_HI stage, latch
   (* keep *) wire [63:0]         p_n_hi;     // eng.n_hi: c(v + 1)'s W_HI (COUNT_W > 32 only:
   (* keep *) wire [63:0]         p_o_hi;     // eng.o_hi: c(v)'s           task data_w40)
-  (* keep *) wire                p_lat_valid;  // eng.lat_valid_q: COUNT_HI's latch (COUNT_W > 32
-  (* keep *) wire [3:0]          p_lat_ch;     // eng.lat_ch_q    only: connected by task data_w40)
-  (* keep *) wire [31:0]         p_lat_q;      // eng.lat_q
+  (* keep *) wire [31:0]         p_lat_q;      // eng.lat_q (COUNT_W > 32 only: task data_w40)
   (* keep *) wire [NPEEK*AW-1:0] f_peek_addr = {a_hi, a_sdel, a_stim, a_sbase, a_edge, a_mot,
                                                 a_plat, a_ilat, a_scnt, a_ceil, a_pre, a_cnt};
   (* keep *) wire [NPEEK*4-1:0]  f_slot_addr = {NPEEK{f_ch}};  // -> eng.u_pend.f_peek_addr

@@ -504,11 +504,14 @@ async def read_after_write_wait(dut):
 async def count_hi_save_wait(dut):
     """COUNT_W > 32 with two channels or more: a COUNT_LO read of channel k after one of channel j
     stores j's COUNT_HI latch (the high word of j's count at that read) in the engine's memory;
-    COUNT_HI of j reads that word afterwards. A read or write of j requested right after the read
-    of k is answered at most P + ENGINE_SAVE_WAIT clocks after that read's answer, and
-    P + ENGINE_SAVE_WAIT_REQ after its request when it did not wait; when j had a write not yet
-    stored, the read of k waits for it: answered at most P + ENGINE_SAVE_READ after that write's
-    answer (the RDL). At every phase of the visits; each bound within 2 clocks at some phase."""
+    COUNT_HI of j reads that word afterwards. A read or write of j requested after the read of k
+    (the next request) waits for the store: it is answered at most P + ENGINE_SAVE_WAIT clocks
+    after that read's answer (P + ENGINE_SAVE_WAIT_REQ after its request when it did not wait), or
+    in its own clocks when it comes later; when j had a write not yet stored, the read of k waits
+    for it: answered at most P + ENGINE_SAVE_READ after that write's answer (the RDL). Each case at
+    every phase of the visits, right after the read of k; a COUNT_LO read of j (which stores k's
+    latch in turn) also after 0 .. P + 24 idle clocks at three phases, so that it comes as j's
+    store ends. Each bound is met within 2 clocks at some phase."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     if not env.engine or env.count_w <= 32 or n < 2:
@@ -517,7 +520,10 @@ async def count_hi_save_wait(dut):
     raw = WbRaw(dut)
     p = engine_period(n)
     worst = {"answer": 0, "request": 0, "k read": 0}
-    for rel, case in [(rel, c) for rel in range(p) for c in ("read", "write", "j written")]:
+    runs = [(rel, c, 0) for rel in range(p)
+            for c in ("read", "write", "count_lo", "j written", "j written, k state written")]
+    runs += [(rel, "count_lo", d) for rel in rng.sample(range(p), 3) for d in range(1, p + 25)]
+    for rel, case, idle in runs:
         j = rng.randrange(n)
         k = rng.choice([c for c in range(n) if c != j])
         hi = rng.getrandbits(32) & ((1 << (env.count_w - 32)) - 1)
@@ -526,33 +532,44 @@ async def count_hi_save_wait(dut):
         await ClockCycles(dut.clk, p + ENGINE_WAIT)
         await raw.access(addr("COUNT_LO", j))  # COUNT_HI's latch: j's
         await at_phase(dut, p, rel)
-        if case == "j written":  # j has a write not stored yet: the read of k waits for it
+        if case.startswith("j written"):  # j has a write not stored yet: the read of k waits for it
             await raw.access(addr("PRESET_LO", j), rng.getrandbits(32))
             w_done = int(raw.tb.value)
+        if case.endswith("k state written"):  # ... and k a state write, stored sooner than j's
+            await raw.access(addr("IRQ_EN", k), 0)
         r, _, _ = await raw.access(addr("COUNT_LO", k))  # ... stored, the latch k's
         r_done = int(raw.tb.value)
-        if case == "write":
-            await raw.access(addr("IRQ_EN", j), 0)
-        else:
-            await raw.access(addr("PRESET_LO", j))
-        done = int(raw.tb.value)
-        what = f"channel {j}: an access ({case}) right after a COUNT_LO read of channel {k} answered"
-        assert done - r_done <= p + ENGINE_SAVE_WAIT, \
-            f"{what} {done - r_done} clocks after that read's answer (bound P + {ENGINE_SAVE_WAIT}, P {p})"
-        worst["answer"] = max(worst["answer"], done - r_done - p)
-        if case == "j written":
+        if case.startswith("j written"):
             assert r_done - w_done <= p + ENGINE_SAVE_READ, \
                 f"channel {k}: a COUNT_LO read after a write of channel {j} (whose latch it stores) " \
                 f"answered {r_done - w_done} clocks after that write's answer (bound P + {ENGINE_SAVE_READ})"
             worst["k read"] = max(worst["k read"], r_done - w_done - p)
+        if idle:
+            await ClockCycles(dut.clk, idle)
+        if case == "write":
+            a = (await raw.access(addr("IRQ_EN", j), 0))[0]
+            own = ENGINE_ANSWER
+        elif case == "count_lo":  # (itself a COUNT_LO read of another channel than k: it stores k's)
+            a = (await raw.access(addr("COUNT_LO", j)))[0]
+            own = ENGINE_READ_ANSWER + 1
         else:
+            a = (await raw.access(addr("PRESET_LO", j)))[0]
+            own = ENGINE_READ_ANSWER
+        done = int(raw.tb.value)
+        what = f"channel {j}: an access ({case}, {idle} idle clocks) after a COUNT_LO read of channel {k} answered"
+        assert done - a <= own or done - r_done <= p + ENGINE_SAVE_WAIT, \
+            f"{what} {done - r_done} clocks after that read's answer, {done - a} after its own " \
+            f"request (bound P + {ENGINE_SAVE_WAIT}, or {own} after its own request; P {p})"
+        if done - a > own:  # (it waited for the store)
+            worst["answer"] = max(worst["answer"], done - r_done - p)
+        if not case.startswith("j written") and not idle:
             assert done - r <= p + ENGINE_SAVE_WAIT_REQ, \
                 f"{what} {done - r} clocks after that read's request (bound P + {ENGINE_SAVE_WAIT_REQ}, P {p})"
             worst["request"] = max(worst["request"], done - r - p)
         got = (await raw.access(addr("COUNT_HI", j)))[1]
         assert got == hi, f"channel {j}: COUNT_HI {got:#x} after its latch was stored, {hi:#x} written"
-    dut._log.info("an access of channel j right after a COUNT_LO read that stored j's latch: answered "
-                  "at worst P + %d after that read's answer (bound P + %d), P + %d after its request "
+    dut._log.info("an access of channel j after a COUNT_LO read that stored j's latch: answered at "
+                  "worst P + %d after that read's answer (bound P + %d), P + %d after its request "
                   "(bound P + %d); that read, after a write of j: P + %d after the write's answer "
                   "(bound P + %d); P %d", worst["answer"], ENGINE_SAVE_WAIT, worst["request"],
                   ENGINE_SAVE_WAIT_REQ, worst["k read"], ENGINE_SAVE_READ, p)
