@@ -46,7 +46,7 @@ module enc_qei_ram #(
   assign rdata_b = rdata_b_q;
 
 `ifdef FORMAL
-  // A proof's view of F_PEEK words (formal/enc_qei_engine.sby, tasks data and data_ch3, read
+  // A proof's view of F_PEEK words (formal/enc_qei_engine.sby, its data tasks, which read
   // this file with FORMAL defined and drive f_peek_addr after flatten): word i of f_peek is
   // mem[f_peek_addr[i]] now, no clock.
   localparam integer F_PEEK = 12;

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei's shared engine (ENGINE = 1) against its promises, the RDL text of CAPS.ENGINE's value
 shared (P = 24 x max(CHANNELS, 2), the constants ENGINE_* of enctools.qei.env), on 1, 3 and 16
-channels, and the same tests on a build with a datapath per channel (the reference: every value
+channels and on 2 channels at COUNT_W 64, and the same tests on a build with a datapath per channel (the reference: every value
 the same, shown at once):
 
 - latency: a step shows in COUNT at most P + 24 clocks later than on the per-channel build, an
@@ -14,6 +14,10 @@ the same, shown at once):
   event after it stays), in order with the reads and writes after it; a read right after a write
   sees it and is answered at most P + 66 clocks after the write's request (P + 30 after a state
   write, P + 68 after a COUNT_LO write with some byte lanes off), and at some phase that late;
+- COUNT_W > 32: a COUNT_LO read of another channel stores the COUNT_HI latch of the channel read
+  before, and the next access of that channel waits for the store (P + 23 after that read's
+  answer, P + 29 after its request); that read waits for the other channel's unstored write
+  (P + 63 after its answer);
 - every value exact: independent clock-exact random walks on every channel at the count-rate bound
   with index presets and latches, global snapshots every few hundred clocks, each channel against
   its own model; channels isolated from each other's bus traffic; reset in mid-motion;
@@ -23,8 +27,8 @@ the same, shown at once):
   when its source is stopped (GSNAP_CTRL.PERIOD_EN written 0) is still taken, at most P clocks
   after the write's snapshot clock, and GSNAP_TIME holds still from P + 44 clocks after it.
 
-Runs on ENGINE_CONFIGS (enc_qei_wb, lean, COUNT_W 32, TS_W 32; 16 channels on Verilator whatever
-SIM says). Every cocotb test logs its seed.
+Runs on ENGINE_CONFIGS (enc_qei_wb, lean, COUNT_W 32 or 64, TS_W 32; 16 channels on Verilator
+whatever SIM says). Every cocotb test logs its seed.
 """
 
 from __future__ import annotations
@@ -38,17 +42,17 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from enctools.qei.bus import WbRaw, signed
 from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
-                              ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SHOW, ENGINE_SHOW_COUNT,
-                              ENGINE_SAVE_READ, ENGINE_SAVE_WAIT, ENGINE_SAVE_WAIT_REQ, ENGINE_STATE_WAIT, ENGINE_WAIT,
-                              PER_CHANNEL_ANSWER, PROFILES, begin,
-                              build_name,
-                              channel_envs, engine_period, read_snapshot)
+                              ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SAVE_READ,
+                              ENGINE_SAVE_WAIT, ENGINE_SAVE_WAIT_REQ, ENGINE_SHOW,
+                              ENGINE_SHOW_COUNT, ENGINE_STATE_WAIT, ENGINE_WAIT,
+                              PER_CHANNEL_ANSWER, PROFILES, begin, build_name, channel_envs,
+                              engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
 from enctools.qei.stimulus import ClockWalk, pulse_rst
 from enctools.regmap import addr, built_mask, event_bits, field, pack, regmap, units
 from enctools.tb import cocotb_test
 
-# (top, CHANNELS, ENGINE): the reference build with a datapath per channel, then the engine
+# (top, CHANNELS, ENGINE, COUNT_W): the reference build with a datapath per channel, then the engine
 ENGINE_CONFIGS = (("enc_qei_wb", 1, 0, 32), ("enc_qei_wb", 1, 1, 32), ("enc_qei_wb", 3, 1, 32),
                   ("enc_qei_wb", 16, 1, 32), ("enc_qei_wb", 2, 1, 64))
 
