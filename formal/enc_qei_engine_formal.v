@@ -264,9 +264,11 @@ module enc_qei_engine_formal #(
                              (p_b_st == B_DONE && p_pend_we) ? (1 << p_b_ch) : 0));
       if (p_pend_we) assert (f_save1 ? (p_b_st == B_WAIT && p_pend_wch == f_save_ch) :
                                        (p_b_st == B_DONE && p_pend_wch == p_b_ch));
+      // COUNT_W > 32, COUNT_HI's latch (task prove_w40): the store a COUNT_LO read of another
+      // channel makes is one post, into a channel with no write in flight; it clears the latch
       if (f_save1) assert (p_pend_we && COUNT_W > 32 && !p_lat_valid && f_save_ch != p_b_ch);
-      if (COUNT_W > 32 && p_lat_valid) assert (p_lat_ch < CHANNELS &&
-                                               !(f_wsave[p_lat_ch] && (p_pend[p_lat_ch] || p_busy[p_lat_ch])));
+      if (COUNT_W > 32 && p_lat_valid)
+        assert (p_lat_ch < CHANNELS && !(f_wsave[p_lat_ch] && (p_pend[p_lat_ch] || p_busy[p_lat_ch])));
       if (f_lw_v && !f_after[f_lw]) assert (f_lw < CHANNELS && f_wage[f_lw] == f_lwage);
       // (the last request: a write, posted once; a read that stored a latch, posted once)
       if (f_pw && !f_out_q) assert (f_cur[f_pch]);
@@ -277,8 +279,6 @@ module enc_qei_engine_formal #(
       if (f_pw && f_cur[f_pch]) assert (f_lw_v && f_lw == f_pch && !f_after[f_pch] && !f_psv);
       if (f_psv) assert (!f_pw && f_cur[f_psv_ch] && f_wsave[f_psv_ch] && f_after[f_psv_ch] &&
                          f_psv_ch < CHANNELS);
-      // (the store's age: 3 at least at the answer to the read that made it, which is of another
-      // channel)
       assert ((f_after & ~f_wsave) == {CHANNELS{1'b0}});
       // (a COUNT_LO read holds its channel's latch from its take on)
       if (COUNT_W > 32 && !p_b_wr && p_b_word == OFF_CNT_LO &&
@@ -289,10 +289,14 @@ module enc_qei_engine_formal #(
                                      !(p_pend[f_pch] || p_busy[f_pch]));
       if (COUNT_W > 32 && f_rdw && f_rdw_sv && p_lat_valid && p_lat_ch != f_rdw_ch)
         assert (!(p_pend[p_lat_ch] || p_busy[p_lat_ch]));
-      if (f_psv && f_out_q) assert (f_psv_ch != p_b_ch && {1'b0, f_wage[f_psv_ch]} + {1'b0, f_rem} >= 9'd3);
+      // (the store's age: 3 at least at the answer to the read that made it, which is of another
+      // channel)
+      if (f_psv && f_out_q)
+        assert (f_psv_ch != p_b_ch && {1'b0, f_wage[f_psv_ch]} + {1'b0, f_rem} >= 9'd3);
       if (f_psv && !f_out_q) assert ({1'b0, f_wage[f_psv_ch]} >= {1'b0, f_ka} + 9'd3);
       // (COUNT_W <= 32: no latch, nothing stored; p_lat_valid and p_lat_ch are not connected)
-      if (COUNT_W <= 32) assert (!f_save1 && !f_psv && !f_rdw_sv && !f_lwt && f_wsave == 0 && f_after == 0);
+      if (COUNT_W <= 32)
+        assert (!f_save1 && !f_psv && !f_rdw_sv && !f_lwt && f_wsave == 0 && f_after == 0);
       // the order of the writes in flight: one posted before the last bus write's post is older
       // than it by 4 clocks at least (requests come one at a time); during a request, every write
       // in flight posted before it is older than the request
@@ -616,7 +620,7 @@ module enc_qei_engine_formal #(
   end
 
 `ifdef ENGINE_DATA
-  // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (tasks data, data_ch3, data_w40)
+  // ---- the data path of the count, its latches, PRESET, CEILING and the snapshot (the data tasks)
   // For one channel f (any, fixed; the bus reads and writes any register of f),
   // with the lanes' records free: at each visit of f the engine rebuilds, from the record of f's
   // read and the count it stored before (lane_rebuild of rtl/enc_qei_lane.vh, with PRESET and
