@@ -80,11 +80,7 @@ uint64_t prev_request;
 constexpr int kPages = 64;  // 0x100-byte pages of the address space (a channel's registers)
 uint64_t last_write[kPages];  // each page's last write: its request, or for a write that waited
                               // its answer less answer_bound
-// COUNT_W > 32 on the shared engine with two channels or more: a COUNT_LO read of another channel
-// than the last COUNT_LO read's stores that channel's COUNT_HI latch (waiting for that channel's
-// write not stored yet: answered at most P + 63 clocks after that write's answer), and an access
-// of that channel right after waits for the store: answered at most P + 23 clocks after the
-// read's answer
+// COUNT_W > 32 on the shared engine with two channels or more: the COUNT_HI latch store (above)
 bool save_rule;
 int save_bound;               // P + 23
 int save_read_bound;          // P + 63, from the write's request: P + 67
@@ -117,6 +113,10 @@ void drive_inputs() {
 uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     const uint64_t request = clocks;
     uint64_t answered = request;
+    const int page = addr >> 8 & (kPages - 1);
+    // a COUNT_LO read of another channel than the latch's stores that channel's latch (above)
+    const bool stores = save_rule && !we && (addr & 0xff) == kCountLo && page < channels &&
+        latch_page >= 0 && latch_page != page;
     top->wb_adr_i = addr;
     top->wb_dat_i = *data;
     top->wb_sel_i = sel;
@@ -134,13 +134,10 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
             *data = top->wb_dat_o;
             if (i > longest_answer)
                 longest_answer = i;
-            const int page = addr >> 8 & (kPages - 1);
             const uint64_t since_write = request + i - last_write[page];
             const bool after_save = saved[page] &&
                 request + i - last_save[page] <= static_cast<uint64_t>(save_bound);
-            // (a COUNT_LO read that stores another channel's latch waits for that one's write)
-            const bool stores = save_rule && !we && (addr & 0xff) == kCountLo &&
-                latch_page >= 0 && latch_page != page;
+            // (a read that stores another channel's latch waits for that one's write)
             const bool after_other = stores &&
                 request + i - last_write[latch_page] <= static_cast<uint64_t>(save_read_bound);
             const bool late = i > answer_bound &&
@@ -164,15 +161,12 @@ uint32_t access(uint32_t addr, bool we, uint32_t *data, uint32_t sel) {
     prev_addr = addr;
     prev_we = we;
     prev_request = request;
-    // a COUNT_LO read of another channel stores the latch of the channel read before (above)
-    const int page = addr >> 8 & (kPages - 1);
-    if (save_rule && !we && (addr & 0xff) == kCountLo && page < channels) {
-        if (latch_page >= 0 && latch_page != page) {
-            saved[latch_page] = true;
-            last_save[latch_page] = answered;
-        }
-        latch_page = page;
+    if (stores) {
+        saved[latch_page] = true;
+        last_save[latch_page] = answered;
     }
+    if (save_rule && !we && (addr & 0xff) == kCountLo && page < channels)
+        latch_page = page;  // (the latch is this channel's from now)
     // a write that waited itself counts from its answer less answer_bound (see the top)
     if (we)
         last_write[addr >> 8 & (kPages - 1)] =
