@@ -350,12 +350,12 @@ module enc_qei_engine_formal #(
   // a read requested while a write of its channel is not stored yet: it waits for it (the
   // bounds: below)
   reg                 f_rdw;      // such a read is in flight
+  reg  [3:0]          f_rdw_ch;   // ... of this channel
   reg                 f_rdw_sv;   // ... right after a COUNT_LO read that stored its channel's latch
   wire [7:0]          f_rem;      // clocks from now to the bus's answer, by its state, at most
   reg                 f_lwt;      // COUNT_W > 32: the read waited for the write of the channel
   reg  [3:0]          f_lwt_ch;   // ... whose latch it stores
   reg  [7:0]          f_lwt_age;  // ... that write's clocks since its answer
-  reg  [3:0]          f_rdw_ch;   // ... of this channel
   reg  [7:0]          f_stake [0:CHANNELS-1];  // a taken write's clocks since its take
 
   // clocks from now to the next clock with slot s and channel field (c(v + 1) or c(v)) k
@@ -868,13 +868,13 @@ module enc_qei_engine_formal #(
     end
   endfunction
 
-  function [31:0] stage_merge;  // COUNT_HI's stage after the write w, kept to SZ's high word
-    input [31:0] c;
+  function [31:0] stage_merge;  // COUNT_HI's stage after the write w: the high half of the
+    input [31:0] c;               // COUNT_LO / COUNT_HI pair, merged as PRESET's and CEILING's
     input [41:0] w;
-    reg   [31:0] m;
+    reg   [63:0] m;
     begin
-      m = lanes_of(w[35:32]);
-      stage_merge = ((c & ~m) | (w[31:0] & m)) & SZ[63:32];
+      m = wide_merge({c, 32'd0}, w, OFF_CNT);
+      stage_merge = m[63:32];
     end
   endfunction
 
