@@ -6,6 +6,7 @@ least-squares line through each row, doc/results/synth_channels.md."""
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 
 from .. import core as core_file
@@ -250,7 +251,18 @@ def lane_parts() -> LaneParts | None:
 FLOOR_FILES = ("rtl/enc_filter_rt.v", "tools/enctools/synth/floor/enc_qei_floor_lane.v",
                "tools/enctools/synth/floor/enc_qei_floor_bank.v")
 FLOOR_LANES = 16
-FLOOR_VISIT = 24  # the engine's clocks a visit (ENC_QEI_ENGINE_V of rtl/enc_qei_lane_w.vh)
+
+
+def engine_visit() -> int:
+    """The engine's clocks a visit: ENC_QEI_ENGINE_V of rtl/enc_qei_lane_w.vh."""
+    path = TOP / "rtl" / "enc_qei_lane_w.vh"
+    m = re.search(r"^`define\s+ENC_QEI_ENGINE_V\s+(\d+)\b", path.read_text(), re.M)
+    if not m:
+        raise SystemExit(f"synth: no `define ENC_QEI_ENGINE_V in {path}")
+    return int(m.group(1))
+
+
+FLOOR_VISIT = engine_visit()
 FLOOR_P = (FLOOR_LANES, FLOOR_VISIT * FLOOR_LANES)
 
 
