@@ -214,7 +214,7 @@ async def error_counters_wide(dut):
     await bus.events()
 
 
-@cocotb_test()
+@cocotb_test(timeout_time=6, timeout_unit="ms")  # 2 ms of 65,540 pulses: 3x, for mutation
 async def error_counters_saturate(dut):
     """QERR_COUNT's top bit and its saturation at 0xFFFF ("Number of QERR events, saturating at
     0xFFFF"): 32,770 illegal jumps read 32,770 (bit 15 set), 32,770 more read 0xFFFF, not the sum
@@ -237,7 +237,7 @@ async def error_counters_saturate(dut):
     await bus.events()
 
 
-@cocotb_test()
+@cocotb_test(timeout_time=6, timeout_unit="ms")  # 2 ms of 65,540 pulses: 3x, for mutation
 async def glitch_count_saturates(dut):
     """GLITCH_COUNT's top bit and its saturation at 0xFFFF ("Number of clocks with a rejected A/B
     level (GLITCH events), saturating at 0xFFFF"): with FILTER_LEN 2, 32,770 lone one-clock pulses on A or B (each one rejected

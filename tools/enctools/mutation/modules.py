@@ -17,9 +17,11 @@ from .data import Module, Suite
 # The enc_qei feature files share one environment (enctools.qei.env): one build per
 # configuration, so each configuration's tests run in one simulation per mutant set. Their suites
 # are long (40 to 70 s unmutated): a test runs on the unmutated design only once it has killed,
-# the limit is fixed (1.5 ms of simulated time: the longest tests, period_capture and the
-# count-rate bench's exact_at_bound, take 0.7 ms), and a mutant alive after a third of the first
-# group's tests is checked for equivalence at once.
+# the limit is fixed (1.5 ms of simulated time: period_capture and the count-rate bench's
+# exact_at_bound take 0.7 ms; the two saturation tests of test_compare_events take 2 ms and have
+# a timeout of their own, which is their limit here), and a mutant alive after a third of the
+# first group's tests is checked for equivalence at once. A test that takes more than half its
+# limit unmutated stops the run with its name (a timeout would not prove a kill).
 QEI_SUITE = Suite(lazy=True, limit_ns=1_500_000, cap=0.35)
 FEATURES = "tb/enc_qei"
 CHANNELS = "tb/enc_qei/test_channels.py"  # several channels: for the modules that page them
@@ -43,7 +45,8 @@ ENGINE_CORNERS = ("tb/enc_qei/test_engine.py::*[enc_qei_wb-ch3-engine]",
                   "tb/enc_qei/*[enc_qei_wb-c32-t32-engine]")
 
 
-# the shared engine's tests wait for its latency: the longest feature test takes 1.7 ms there
+# the shared engine's tests wait for its latency: the longest feature test without a timeout of
+# its own takes 1.7 ms there
 ENGINE_SUITE = Suite(lazy=True, limit_ns=4_000_000, cap=0.35)
 
 
