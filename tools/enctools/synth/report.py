@@ -55,6 +55,8 @@ def placed_cell(r: Result) -> str:
     if r.placed is None:
         return "-"
     unit = "LC" if PLACED_CELL[r.block.device] == "ICESTORM_LC" else "COMB"
+    if r.packed_only:
+        return f"needs {r.placed:,} / {r.placed_of:,} {unit} (packed, {100 * r.placed / r.placed_of:.0f} %)"
     return f"{r.placed:,} / {r.placed_of:,} {unit}"
 
 
@@ -166,7 +168,9 @@ def markdown(results: list[Result | dict]) -> str:
         "and distributed RAM) of the part's. A build with more LUT4, flip-flops or block RAMs than "
         f"its part holds ({CAPACITY['hx8k']:,} logic cells and {BRAM_CAPACITY['hx8k']} SB_RAM40_4K on "
         f"the HX8K; {CAPACITY['ecp5']:,} LUT4, where each CCU2C takes two more, and "
-        f"{BRAM_CAPACITY['ecp5']} DP16KD on the LFE5U-25F) is not placed. ENGINE=1: the channels "
+        f"{BRAM_CAPACITY['ecp5']} DP16KD on the LFE5U-25F) is not placed: its placed cell shows the "
+        "sites it needs once nextpnr has packed it (--pack-only; a flip-flop or carry that cannot share "
+        "a LUT4's site takes one of its own, so this is more than the LUT4 column). ENGINE=1: the channels "
         "share one engine (rtl/enc_qei_engine.v); without it, a datapath per channel. LUT4 versus "
         "CHANNELS for both, with the cost of one more channel: "
         f"[{CHANNELS_MD.name}]({CHANNELS_MD.name}).",
