@@ -150,17 +150,27 @@ async def steps_at_patterned_ceilings(dut):
     """CEILINGs with bit patterns from a fixed seed (deterministic: random.Random(1414), the same
     list every run), each range, counts one step and one or five units of a 16-bit slice away:
     the slice comparators of the at-CEILING flags with every carry pattern, under steps in
-    consecutive clocks (the BURST of steps_in_consecutive_clocks)."""
+    consecutive clocks (the BURST of steps_in_consecutive_clocks). Then the WIDE CEILINGs and
+    their complements (every bit of CEILING - 2, CEILING - 1 and CEILING both 0 and 1 among them,
+    so that no bit of a flag's comparator is left at one value) in every range, from one and two
+    steps below CEILING and one above: the +1 candidate of a flag (CEILING - 2's comparator) is
+    read only by a step in the clock right after a step."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     top = model.max
     pick = random.Random(1414)
+    cases = []
     for i in range(12):
         mode = ("modulo", "limit", "non_recycle")[i % 3]
         sl = pick.randrange(0, env.count_w // 16)
         ceiling = pick.getrandbits(env.count_w) >> pick.randrange(0, env.count_w)
+        cases.append((mode, ceiling, (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl))))
+    for ceiling in WIDE + tuple(~v for v in WIDE):
+        for mode in ("modulo", "limit", "non_recycle"):
+            cases.append((mode, ceiling & top, (-2, -1, 1)))
+    for mode, ceiling, ds in cases:
         await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
-        for d in (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl)):
+        for d in ds:
             start = ceiling + d
             if not 0 <= start <= top:
                 continue
