@@ -641,8 +641,10 @@ module enc_qei_engine_formal #(
   // these words. The _HI halves' reads answer bits 63:32 of the words. COUNT_HI: a write of f
   // (a state write) is taken at f's visit and written by f's write-back in slot 8 into the
   // stage (W_HI[63:32]), its bytes merged; a COUNT_LO write loads {stage at the visit, value};
-  // with COUNT_W > 32, COUNT_LO read on f only (the assumption below), the engine's latch holds
-  // the high word of f's count at that read, and COUNT_HI answers it.
+  // with COUNT_W > 32 the engine's latch, while it is f's, holds the high word of f's count at
+  // f's last COUNT_LO read; a COUNT_LO read of another channel stores it into f's slot (a state
+  // write, offset 0x3F), f's visit takes it and f's write-back writes it into W_HI[31:0] in slot
+  // 8, and COUNT_HI of f answers that word from then on.
   // The snapshot's other words, the same way: from the record of f's read (its motion, last edge
   // and snapshot fields) with the timebase in the read's clock and the motion, last edge and last
   // snapshot as stored at the visit (W_MOT, W_EDGE, W_SBASE), through rtl/enc_qei_lane.vh's
@@ -761,6 +763,11 @@ module enc_qei_engine_formal #(
   reg              f_hk;     // f's visit took a COUNT_HI write (a state write, slot 21)
   reg  [41:0]      f_hx;     // ... this one
   reg  [31:0]      f_stage;  // COUNT_HI's stage as stored (W_HI[63:32]; f's write-back writes it)
+  reg  [31:0]      f_mlat;   // f's COUNT_HI latch as stored (W_HI[31:0]: a store of it writes it)
+  reg  [31:0]      f_vmlat;  // ... at f's visit
+  reg              f_svf;    // f's latch is being stored (its write: save_w(f_latv)): posted or
+                             // in f's slot
+  reg              f_svt;    // ... taken by f's visit, not yet written by its write-back
   reg  [31:0]      f_vstage; // ... at f's visit (a COUNT_LO write's high word)
   reg  [63:0]      f_pre, f_ceil;    // PRESET and CEILING as stored (f's write-back writes them)
   reg  [63:0]      f_vpre, f_vceil;  // ... at f's visit (the rebuild's)
@@ -834,8 +841,8 @@ module enc_qei_engine_formal #(
                                 (p_b_word == OFF_CNT_HI && f_lat) ? f_latv : 32'd0;
 
   // the offset the bus never writes: 0x3F, which no register has (enc_qei sends the engine mapped
-  // offsets only) and the engine uses for a COUNT_HI latch it stores (none on f: see the
-  // assumption below)
+  // offsets only) and the engine uses for a COUNT_HI latch it stores (save_w: all four byte
+  // enables, the latch's word)
   function left_out;
     input [5:0] off;
     begin
@@ -851,7 +858,8 @@ module enc_qei_engine_formal #(
     begin
       watched_w = |w[35:32] && (w[41:36] == OFF_CNT || w[41:36] == OFF_PRE ||
                                 w[41:36] == OFF_PRE_HI || w[41:36] == OFF_CEIL ||
-                                w[41:36] == OFF_CEIL_HI || w[41:36] == OFF_CNT_HI);
+                                w[41:36] == OFF_CEIL_HI || w[41:36] == OFF_CNT_HI ||
+                                w[41:32] == {6'h3F, 4'hF});
     end
   endfunction
 
@@ -878,6 +886,13 @@ module enc_qei_engine_formal #(
     end
   endfunction
 
+  function [41:0] save_w;  // the write a store of f's COUNT_HI latch v puts in f's slot
+    input [31:0] v;
+    begin
+      save_w = {6'h3F, 4'hF, v};
+    end
+  endfunction
+
   function [31:0] lanes_of;  // byte enables -> bit mask
     input [3:0] st;
     begin
@@ -892,17 +907,13 @@ module enc_qei_engine_formal #(
     input        ok;
     input [41:0] x;
     begin
-      slot_ok = !left_out(w[41:36]) && (watched_w(w) ? (ok && w == x) : !ok);
+      slot_ok = watched_w(w) ? (ok && w == x) : (!ok && !left_out(w[41:36]));
     end
   endfunction
 
   always @(*) begin
     assume (f_ch < CHANNELS);
     if (req_valid && req_write && req_ch == f_ch) assume (!left_out(req_word));
-    // COUNT_W > 32: COUNT_LO is read on f only, so the engine's one COUNT_HI latch is always f's
-    // and never stored (that store, a COUNT_LO read of another channel, and the wait it makes
-    // are checked in simulation: test_engine's count_hi_save_wait)
-    if (COUNT_W > 32 && req_valid && !req_write && req_word == OFF_CNT) assume (req_ch == f_ch);
   end
 
   always @(posedge clk) begin
@@ -929,6 +940,9 @@ module enc_qei_engine_formal #(
       f_lk   <= 1'b0;
       f_hk   <= 1'b0;
       f_stage <= 32'd0;
+      f_mlat <= 32'd0;
+      f_svf  <= 1'b0;
+      f_svt  <= 1'b0;
       f_pk   <= 1'b0;
       f_pre  <= PRE_RST;
       f_ceil <= CEIL_RST;
@@ -973,6 +987,7 @@ module enc_qei_engine_formal #(
         f_hk     <= p_e_taken && f_pk;
         f_hx     <= f_px;
         f_vstage <= f_stage;
+        f_vmlat  <= f_mlat;
         f_base   <= f_sto;
         f_vpre   <= f_pre;
         f_vceil  <= f_ceil;
@@ -985,6 +1000,21 @@ module enc_qei_engine_formal #(
       if (f_wbv && p_slot == 5'd5 && f_lk) f_ceil <= wide_merge(f_ceil, f_lx, OFF_CEIL);
       // COUNT_HI's stage: f's write-back writes the COUNT_HI write its visit took (slot 8)
       if (f_wbv && p_slot == W_HI && f_hk) f_stage <= stage_merge(f_stage, f_hx);
+      // f's COUNT_HI latch: a COUNT_LO read of another channel stores it (posts it into f's slot)
+      // while the engine holds it; f's write-back writes it (slot 8)
+      if (f_save_go && p_lat_ch == f_ch) begin
+        f_svf <= 1'b1;
+        f_pk  <= 1'b1;
+        f_px  <= save_w(f_latv);
+      end
+      if (f_calc && p_e_taken && f_svf) begin
+        f_svf <= 1'b0;
+        f_svt <= 1'b1;
+      end
+      if (f_wbv && p_slot == W_HI && f_hk && f_hx[41:36] == 6'h3F) begin
+        f_mlat <= f_hx[31:0];
+        f_svt  <= 1'b0;
+      end
       if (f_wb) f_sto <= f_new;
       if (f_wbv && p_slot == S_SCNT && (f_spend || f_fresh)) f_scnt <= f_snew;
       if (f_wbv && p_slot == S_ILATCH && (f_ipend || f_fresh)) f_ilat <= f_inew;
@@ -1051,15 +1081,17 @@ module enc_qei_engine_formal #(
           !(&p_b_wstrb)) assert (p_b_cnt == f_bcnt);
       if (p_pend_we && p_pend_wch == f_ch) assert (slot_ok(p_pend_wd, f_pk, f_px));
       if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pk, f_px));
-      // (a state write: none of them but COUNT_HI)
-      if (|((p_pend | p_busy) & p_pend_st & (1 << f_ch))) assert (!f_pk || f_px[41:36] == OFF_CNT_HI);
-      if (|((p_pend | p_busy) & ~p_pend_st & (1 << f_ch))) assert (!f_pk || f_px[41:36] != OFF_CNT_HI);
+      // (a state write: none of them but COUNT_HI and a store of f's latch)
+      if (|((p_pend | p_busy) & p_pend_st & (1 << f_ch)))
+        assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == 6'h3F);
+      if (|((p_pend | p_busy) & ~p_pend_st & (1 << f_ch)))
+        assert (!f_pk || (f_px[41:36] != OFF_CNT_HI && f_px[41:36] != 6'h3F));
       if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pk, f_px));
       if (p_cp == f_ch) begin
         assert (p_p_taken ? slot_ok(p_p_pend, f_lk, f_lx) : !f_lk);
-        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk || f_px[41:36] == OFF_CNT_HI);
+        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == 6'h3F);
         if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, f_pk, f_px));
-        if (p_p_taken && f_lk) assert (f_lx[41:36] != OFF_CNT_HI);
+        if (p_p_taken && f_lk) assert (f_lx[41:36] != OFF_CNT_HI && f_lx[41:36] != 6'h3F);
       end
       // the count word of f: written whole in slot 0 of each of f's write-backs (always pending)
       stored_word(a_cnt, 5'd0, 1'b1, f_new, m_cnt, f_sto, p_n_cnt, 1'b1);
@@ -1090,10 +1122,11 @@ module enc_qei_engine_formal #(
       if (f_wbv) begin
         if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
         assert (p_ip_pre == {f_lk && f_lx[41:36] == OFF_PRE_HI, f_lk && f_lx[41:36] == OFF_PRE});
-        assert (p_ip_hi == {f_hk && f_hx[41:36] == OFF_CNT_HI, 1'b0});
-        if (f_hk) assert (f_hx[41:36] == OFF_CNT_HI && !f_lk);
+        assert (p_ip_hi == {f_hk && f_hx[41:36] == OFF_CNT_HI, f_hk && f_hx[41:36] == 6'h3F});
+        if (f_hk) assert ((f_hx[41:36] == OFF_CNT_HI || f_hx[41:32] == {6'h3F, 4'hF}) && !f_lk);
         if (|p_ip_hi) assert (p_ip_data == f_hx[31:0] && p_ip_lanes == lanes_of(f_hx[35:32]));
         assert (f_stage == ((p_slot > W_HI && f_hk) ? stage_merge(f_vstage, f_hx) : f_vstage));
+        assert (f_mlat == ((p_slot > W_HI && f_hk && f_hx[41:36] == 6'h3F) ? f_hx[31:0] : f_vmlat));
         assert (p_ip_ceil == {f_lk && f_lx[41:36] == OFF_CEIL_HI, f_lk && f_lx[41:36] == OFF_CEIL});
         if (|p_ip_pre || |p_ip_ceil)
           assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
@@ -1135,22 +1168,36 @@ module enc_qei_engine_formal #(
       if (f_chk) assert ((p_b_st == B_RD2 || p_b_st == B_DONE || (p_b_st == B_IDLE && resp_valid)) &&
                          p_b_ch == f_ch && !p_b_wr && f_watched && p_b_rdata == f_exp);
       if (f_chk && resp_valid) assert (resp_rdata == f_exp);
-      // W_HI of f: the stage as stored, and 0 for the stored latch (no latch of f is stored: see
-      // the assumption); 0 before f's first write-back (which writes it whole); as the visits
-      // read it
+      // W_HI of f: the stage and the latch as stored; 0 before f's first write-back (which
+      // writes it whole); as the visits read it
       assert ((f_stage & ~SZ[63:32]) == 32'd0);
-      if (!f_fresh || (f_wbv && p_slot > W_HI)) assert (m_hi == {f_stage, 32'd0});
-      else assert (f_stage == 32'd0);
+      if (!f_fresh || (f_wbv && p_slot > W_HI)) assert (m_hi == {f_stage, f_mlat});
+      else assert (f_stage == 32'd0 && f_mlat == 32'd0);
       // COUNT_W > 32 (n_hi, o_hi and the latch are built then only): the visits' copies of W_HI;
-      // the engine's one COUNT_HI latch is f's (COUNT_LO is read on f only), and holds the high
-      // word of f's count as the last COUNT_LO read of f took it
-      if (COUNT_W <= 32) assert (!f_lat);  // (COUNT_HI reads 0)
+      // the engine's one COUNT_HI latch, when it is f's, holds the high word of f's count as the
+      // last COUNT_LO read of f took it; when it is not, that word is being stored (f_svf: the
+      // write is posted, in f's slot or taken by f's visit) or is the stored one
+      if (COUNT_W <= 32)  // (COUNT_HI reads 0; no latch, nothing stored)
+        assert (!f_lat && !f_svf && !f_svt && f_mlat == 32'd0 && !(f_pk && f_px[41:36] == 6'h3F) &&
+                !(f_hk && f_hx[41:36] == 6'h3F));
       if (COUNT_W > 32) begin
-        if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == {f_stage, 32'd0});
-        if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == {f_stage, 32'd0});
-        assert (p_lat_valid == f_lat);
-        if (p_b_st != B_IDLE && !p_b_wr && p_b_word == OFF_CNT) assert (p_b_ch == f_ch);
-        if (f_lat) assert (p_lat_ch == f_ch && p_lat_q == f_latv);
+        if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == {f_stage, f_mlat});
+        if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == {f_stage, f_mlat});
+        if (p_lat_valid && p_lat_ch == f_ch) assert (f_lat && p_lat_q == f_latv && !f_svf && !f_svt);
+        if (!f_lat) assert (!f_svf && !f_svt && f_mlat == 32'd0);
+        if (f_lat && !(p_lat_valid && p_lat_ch == f_ch) && !f_svf && !f_svt) assert (f_mlat == f_latv);
+        assert (!(f_svf && f_svt));
+        if (f_fresh) assert (f_mlat == 32'd0 && (!f_lat || f_latv == 32'd0));  // (fresh: COUNT 0)
+        // (a store of f's latch: posted, in f's slot or taken at f's visit (f_svf), then in f's
+        // write-back until slot 8 writes it (f_svt))
+        if (f_save1 && f_save_ch == f_ch) assert (f_svf);
+        if ((p_pend[f_ch] || (p_busy[f_ch] && p_cp == f_ch)) && f_pk && f_px[41:36] == 6'h3F) assert (f_svf);
+        if (f_wbv && p_slot <= W_HI && f_hk && f_hx[41:36] == 6'h3F) assert (f_svt);
+        if (f_svf) begin
+          assert (f_lat && f_pk && f_px == save_w(f_latv));
+          assert ((f_save1 && f_save_ch == f_ch) || p_pend[f_ch] || (p_busy[f_ch] && p_cp == f_ch));
+        end
+        if (f_svt) assert (f_lat && f_wbv && p_busy[f_ch] && p_slot <= W_HI && f_hk && f_hx == save_w(f_latv));
       end
     end
   end
