@@ -503,6 +503,83 @@ async def lanes_probe_compare_per_channel(dut):
 
 
 @cocotb_test()
+async def enable_overflow_glitches_per_channel(dut):
+    """Per channel, on every channel at the same time, what its lane does with its own
+    configuration and pins: CTRL.EN 0 on the odd channels while every channel walks up across the
+    top of the free range from just below it (channel k from max - 3 - k: the enabled ones
+    OVERFLOW once and no DIR_CHANGE, the others keep COUNT and raise nothing); an index preset of
+    PRESET = max - 2 - k, then steps up across the top within the same engine window (the count
+    loaded by the index, then OVERFLOW from it), and the same with PRESET = 2^(COUNT_W - 1) - 2 - k
+    (steps across the lane's low bits' wrap, far from the top: no OVERFLOW); steps down (one
+    DIR_CHANGE), then more steps down (none); then 2k + 3 lone one-clock pulses of A on channel k
+    at FILTER_LEN 2: GLITCH_COUNT 2k + 3 and EVENTS.GLITCH on channel k, COUNT unchanged. COUNT
+    and EVENTS as each channel's model."""
+    envs, rng = await start_channels(dut)
+    models = [QeiModel(env.count_w) for env in envs]
+    pairs = list(zip(envs, models))
+
+    async def walk_all(marks=None, step=1):
+        tasks = []
+        for k, (env, model) in enumerate(pairs):
+            n = 8 + k % 4
+            zf = (lambda p, m=env.pos + 2 * step: int(p == m)) if marks else None
+            tasks.append(cocotb.start_soon(
+                env.play(walk([step] * n, [3 * T_NS] * n, start_pos=env.pos), model, zfun=zf)))
+        for t in tasks:
+            await t
+
+    for k, (env, model) in enumerate(pairs):
+        await env.setup(model, count=model.max - 3 - k, en=int(k % 2 == 0), filter_len=1)
+    await walk_all()
+    for k, (env, model) in enumerate(pairs):
+        await env.check(model, f"channel {k}: EN {int(k % 2 == 0)}, steps up across the top")
+    for top in (True, False):
+        for k, (env, model) in enumerate(pairs):
+            await env.setup(model, count=k, filter_len=1)
+            preset = (model.max if top else model.max >> 1) - 2 - k
+            await env.bus.set64("PRESET", preset)
+            await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+            model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+            model.idx_gate, model.idx_oneshot, model.idx_hits = None, False, 0
+        await envs[-1].applied()
+        await walk_all(marks=True)
+        for k, (env, model) in enumerate(pairs):
+            assert model.idx_hits == 1, f"channel {k}: {model.idx_hits} index pulses played, not 1"
+            await env.check(model, f"channel {k}: index preset of {model.preset:#x}, steps up from it")
+            await env.bus.wr("INDEX_CTRL", 0)
+            model.idx_action = "none"
+    for rnd in range(2):
+        await walk_all(step=-1)
+        for k, (env, model) in enumerate(pairs):
+            await env.check(model, f"channel {k}: steps down ({'after steps up' if rnd == 0 else 'again'})")
+    for k, (env, model) in enumerate(pairs):
+        await env.setup(model, count=0x100 + k, filter_len=2)
+        await env.bus.wr("GLITCH_COUNT", 0)
+    await envs[-1].applied()
+    await envs[-1].settle()
+    for env in envs:
+        await env.bus.events()
+    pulses = [2 * k + 3 for k in range(len(envs))]
+    for i in range(max(pulses)):
+        levels = [env.drv.a.value for env in envs]
+        await FallingEdge(dut.clk)
+        for env, n, a in zip(envs, pulses, levels):
+            if i < n:
+                env.drv.a.value = 1 - a
+        await FallingEdge(dut.clk)
+        for env, a in zip(envs, levels):
+            env.drv.a.value = a
+        await ClockCycles(dut.clk, 2)
+    await envs[-1].settle()
+    for k, (env, model) in enumerate(pairs):
+        await env.check(model, f"channel {k}: {pulses[k]} lone pulses of A", events=False)
+        got = await env.bus.rd("GLITCH_COUNT")
+        assert got == pulses[k], f"channel {k}: GLITCH_COUNT {got} after {pulses[k]} lone pulses of A"
+        ev = await env.bus.events()
+        assert ev == {"GLITCH"}, f"channel {k}: EVENTS {sorted(ev)} after lone pulses, not GLITCH only"
+
+
+@cocotb_test()
 async def presets_ranges_periods_per_channel(dut):
     """Per channel, through its own page and pins, what the shared engine keeps per channel and
     hands to each lane: index presets of PRESET with every low bit both ways (two PRESETs, one
