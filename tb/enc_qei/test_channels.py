@@ -509,8 +509,9 @@ async def enable_overflow_glitches_per_channel(dut):
     top of the free range from just below it (channel k from max - 3 - k: the enabled ones
     OVERFLOW once and no DIR_CHANGE, the others keep COUNT and raise nothing); an index preset of
     PRESET = max - 2 - k, then steps up across the top within the same engine window (the count
-    loaded by the index, then OVERFLOW from it), and the same with PRESET = 2^(COUNT_W - 1) - 2 - k
-    (steps across the lane's low bits' wrap, far from the top: no OVERFLOW); steps down (one
+    loaded by the index, then OVERFLOW from it); an index latch from COUNT = 2^(COUNT_W - 1) - 2 - k
+    (INDEX_LATCH on every channel; steps across the lane's low bits' wrap, far from the top: no
+    OVERFLOW); steps down (one
     DIR_CHANGE), then more steps down (none); then 2k + 3 lone one-clock pulses of A on channel k
     at FILTER_LEN 2: GLITCH_COUNT 2k + 3 and EVENTS.GLITCH on channel k, COUNT unchanged. COUNT
     and EVENTS as each channel's model."""
@@ -533,19 +534,21 @@ async def enable_overflow_glitches_per_channel(dut):
     await walk_all()
     for k, (env, model) in enumerate(pairs):
         await env.check(model, f"channel {k}: EN {int(k % 2 == 0)}, steps up across the top")
-    for top in (True, False):
+    for action in ("preset", "latch"):
         for k, (env, model) in enumerate(pairs):
-            await env.setup(model, count=k, filter_len=1)
-            preset = (model.max if top else model.max >> 1) - 2 - k
-            await env.bus.set64("PRESET", preset)
-            await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
-            model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+            value = (model.max if action == "preset" else model.max >> 1) - 2 - k
+            await env.setup(model, count=k if action == "preset" else value, filter_len=1)
+            await env.bus.set64("PRESET", value)
+            await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
+            model.preset, model.idx_action, model.idx_edge, model.idx_arm = value, action, "rising", True
             model.idx_gate, model.idx_oneshot, model.idx_hits = None, False, 0
         await envs[-1].applied()
         await walk_all(marks=True)
         for k, (env, model) in enumerate(pairs):
             assert model.idx_hits == 1, f"channel {k}: {model.idx_hits} index pulses played, not 1"
-            await env.check(model, f"channel {k}: index preset of {model.preset:#x}, steps up from it")
+            await env.check(model, f"channel {k}: index {action}, steps up")
+            latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
+            assert latch == model.idx_latch, f"channel {k}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
             await env.bus.wr("INDEX_CTRL", 0)
             model.idx_action = "none"
     for rnd in range(2):
