@@ -508,13 +508,12 @@ async def enable_overflow_glitches_per_channel(dut):
     configuration and pins: CTRL.EN 0 on the odd channels while every channel walks up across the
     top of the free range from just below it (channel k from max - 3 - k: the enabled ones
     OVERFLOW once and no DIR_CHANGE, the others keep COUNT and raise nothing); an index preset of
-    PRESET = max - 2 - k, then steps up across the top within the same engine window (the count
-    loaded by the index, then OVERFLOW from it); an index latch from COUNT = 2^(COUNT_W - 1) - 2 - k
-    (INDEX_LATCH on every channel; steps across the lane's low bits' wrap, far from the top: no
-    OVERFLOW); steps down (one
-    DIR_CHANGE), then more steps down (none); then 2k + 3 lone one-clock pulses of A on channel k
-    at FILTER_LEN 2: GLITCH_COUNT 2k + 3 and EVENTS.GLITCH on channel k, COUNT unchanged. COUNT
-    and EVENTS as each channel's model."""
+    PRESET = max - 2 - k, then steps up across the top soon after the load (within about 30
+    clocks: the count loaded by the index, then OVERFLOW from it); an index latch from COUNT =
+    2^(COUNT_W - 1) - 2 - k (INDEX_LATCH on every channel; the steps cross the lane's low bits'
+    wrap far from the top: no OVERFLOW); steps down (one DIR_CHANGE), then more steps down (none);
+    then 2k + 3 lone one-clock pulses of A on channel k at FILTER_LEN 2: GLITCH_COUNT 2k + 3 and
+    EVENTS.GLITCH on channel k, COUNT unchanged. COUNT and EVENTS as each channel's model."""
     envs, rng = await start_channels(dut)
     models = [QeiModel(env.count_w) for env in envs]
     pairs = list(zip(envs, models))
