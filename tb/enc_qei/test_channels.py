@@ -511,7 +511,9 @@ async def enable_overflow_glitches_per_channel(dut):
     PRESET = max - 2 - k, then steps up across the top soon after the load (within about 30
     clocks: the count loaded by the index, then OVERFLOW from it); an index latch from COUNT =
     2^(COUNT_W - 1) - 2 - k (INDEX_LATCH on every channel; the steps cross the lane's low bits'
-    wrap far from the top: no OVERFLOW); steps down (one DIR_CHANGE), then more steps down (none);
+    wrap far from the top: no OVERFLOW); an index preset of PRESET = 2 + k, written over a PRESET
+    with high low-word bits set, then steps down across 0 (UNDERFLOW from the preset's count);
+    two more rounds of steps down (no DIR_CHANGE: the direction is down already);
     then 2k + 3 lone one-clock pulses of A on channel k at FILTER_LEN 2: GLITCH_COUNT 2k + 3 and
     EVENTS.GLITCH on channel k, COUNT unchanged. COUNT and EVENTS as each channel's model."""
     envs, rng = await start_channels(dut)
@@ -533,19 +535,20 @@ async def enable_overflow_glitches_per_channel(dut):
     await walk_all()
     for k, (env, model) in enumerate(pairs):
         await env.check(model, f"channel {k}: EN {int(k % 2 == 0)}, steps up across the top")
-    for action in ("preset", "latch"):
+    # (action, PRESET or COUNT, direction): each PRESET_LO write changes bits the one before set
+    for action, near, step in (("preset", "top", 1), ("latch", "middle", 1), ("preset", "zero", -1)):
         for k, (env, model) in enumerate(pairs):
-            value = (model.max if action == "preset" else model.max >> 1) - 2 - k
-            await env.setup(model, count=k if action == "preset" else value, filter_len=1)
+            value = {"top": model.max - 2 - k, "middle": (model.max >> 1) - 2 - k, "zero": 2 + k}[near]
+            await env.setup(model, count=value if action == "latch" else 0x1000 + k, filter_len=1)
             await env.bus.set64("PRESET", value)
             await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE="rising", ARM=1))
             model.preset, model.idx_action, model.idx_edge, model.idx_arm = value, action, "rising", True
             model.idx_gate, model.idx_oneshot, model.idx_hits = None, False, 0
         await envs[-1].applied()
-        await walk_all(marks=True)
+        await walk_all(marks=True, step=step)
         for k, (env, model) in enumerate(pairs):
             assert model.idx_hits == 1, f"channel {k}: {model.idx_hits} index pulses played, not 1"
-            await env.check(model, f"channel {k}: index {action}, steps up")
+            await env.check(model, f"channel {k}: index {action} near {near}, steps {step:+d}")
             latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
             assert latch == model.idx_latch, f"channel {k}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
             await env.bus.wr("INDEX_CTRL", 0)
