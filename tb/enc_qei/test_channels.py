@@ -20,7 +20,7 @@ from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, wb_abandon_read
-from enctools.qei.env import FILTER, begin, build_name, channel_envs
+from enctools.qei.env import FILTER, begin, build_name, channel_envs, engine_build, engine_period
 from enctools.qei.model import QUAD_FUNCS, QeiModel
 from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import PAGE, addr, built_mask, enum, get_field, pack, regmap, units
@@ -582,6 +582,37 @@ async def enable_overflow_glitches_per_channel(dut):
         assert got == pulses[k], f"channel {k}: GLITCH_COUNT {got} after {pulses[k]} lone pulses of A"
         ev = await env.bus.events()
         assert ev == {"GLITCH"}, f"channel {k}: EVENTS {sorted(ev)} after lone pulses, not GLITCH only"
+
+
+@cocotb_test()
+async def index_right_after_preset_writes(dut):
+    """An index preset at every phase of the shared engine's visits after a PRESET_HI write
+    (every 8 clocks from the write's answer to P + 24 after it; the write gives PRESET_HI the value
+    it has, so PRESET stays max - 5), then steps up across the top of the range: COUNT and
+    OVERFLOW as the model's. The engine hands the lane a written PRESET at its next read, with
+    the validity set that tells the lane whether the top of the range is within reach; one
+    computed from a PRESET the write's merge got wrong acts only in the window up to the read
+    after, so only an index in that window shows it."""
+    envs, rng = await start_channels(dut)
+    env = envs[0]
+    model = QeiModel(env.count_w)
+    span = engine_period(len(envs)) + 24 if engine_build() else 24
+    preset = model.max - 5
+    await env.setup(model, count=0x1000, filter_len=1)
+    await env.bus.set64("PRESET", preset)
+    await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+    model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+    model.idx_gate, model.idx_oneshot = None, False
+    for j in range(0, span, 8):
+        await env.bus.set_count(0x1000)
+        model.write_count(0x1000)
+        await env.settle()
+        await env.bus.wr("PRESET_HI", preset >> 32)
+        await ClockCycles(dut.clk, j)
+        start = env.pos
+        await env.play(walk([1] * 10, [3 * T_NS] * 10, start_pos=start), model,
+                       zfun=lambda p: int(p == start))
+        await env.check(model, f"an index {j} clocks after a PRESET_HI write, then 10 steps up")
 
 
 @cocotb_test()
