@@ -668,7 +668,7 @@ module enc_qei_engine_formal #(
   // (W_STIME), SNAP_DELTA / SNAP_EDGE_DELTA (W_SDELTA), and their write slots
   localparam [4:0]  W_MOT = 5'd9, W_EDGE = 5'd11, W_SBASE = 5'd12, W_STIME = 5'd14,
                     W_SDELTA = 5'd15;
-  localparam [4:0]  W_HI = 5'd8;  // COUNT_HI's latch [31:0] and stage [63:32]: 0 (see below)
+  localparam [4:0]  W_HI = 5'd8;  // COUNT_HI's latch [31:0] and stage [63:32] (see below)
   localparam [4:0]  S_MOT = 5'd9, S_EDGE = 5'd10, S_SBASE = 5'd11, S_STIME = 5'd13, S_SDELTA = 5'd14;
   localparam [31:0] SZ_T = (TS_W >= 32) ? 32'hFFFFFFFF : ((32'd1 << TS_W) - 32'd1);
   localparam integer NPEEK = 12;  // enc_qei_ram's F_PEEK
@@ -677,7 +677,8 @@ module enc_qei_engine_formal #(
                     OFF_PRE = ENC_QEI_PRESET_LO[7:2], OFF_PRE_HI = ENC_QEI_PRESET_HI[7:2],
                     OFF_CEIL = ENC_QEI_CEILING_LO[7:2], OFF_CEIL_HI = ENC_QEI_CEILING_HI[7:2],
                     OFF_STIM = ENC_QEI_SNAP_TIME[7:2], OFF_SETIM = ENC_QEI_SNAP_EDGE_TIME[7:2],
-                    OFF_SDEL = ENC_QEI_SNAP_DELTA[7:2], OFF_SEDEL = ENC_QEI_SNAP_EDGE_DELTA[7:2];
+                    OFF_SDEL = ENC_QEI_SNAP_DELTA[7:2], OFF_SEDEL = ENC_QEI_SNAP_EDGE_DELTA[7:2],
+                    OFF_SAVE = 6'h3F;  // (no register: a stored COUNT_HI latch, see left_out)
   // the high halves (COUNT_W > 32: bits 63:32 of the word; 0 at COUNT_W <= 32) and COUNT_HI (the
   // high word of the count as COUNT_LO's last read of f took it)
   localparam [5:0]  OFF_CNT_HI = ENC_QEI_COUNT_HI[7:2], OFF_SCNT_HI = ENC_QEI_SNAP_COUNT_HI[7:2],
@@ -765,8 +766,8 @@ module enc_qei_engine_formal #(
   reg  [31:0]      f_stage;  // COUNT_HI's stage as stored (W_HI[63:32]; f's write-back writes it)
   reg  [31:0]      f_mlat;   // f's COUNT_HI latch as stored (W_HI[31:0]: a store of it writes it)
   reg  [31:0]      f_vmlat;  // ... at f's visit
-  reg              f_svf;    // f's latch is being stored (its write: save_w(f_latv)): posted or
-                             // in f's slot
+  reg              f_svf;    // f's latch is being stored (its write: save_w(f_latv)): posted, in
+                             // f's slot, or taken by f's visit until its last slot
   reg              f_svt;    // ... taken by f's visit, not yet written by its write-back
   reg  [31:0]      f_vstage; // ... at f's visit (a COUNT_LO write's high word)
   reg  [63:0]      f_pre, f_ceil;    // PRESET and CEILING as stored (f's write-back writes them)
@@ -846,7 +847,7 @@ module enc_qei_engine_formal #(
   function left_out;
     input [5:0] off;
     begin
-      left_out = off == 6'h3F;
+      left_out = off == OFF_SAVE;
     end
   endfunction
 
@@ -859,7 +860,7 @@ module enc_qei_engine_formal #(
       watched_w = |w[35:32] && (w[41:36] == OFF_CNT || w[41:36] == OFF_PRE ||
                                 w[41:36] == OFF_PRE_HI || w[41:36] == OFF_CEIL ||
                                 w[41:36] == OFF_CEIL_HI || w[41:36] == OFF_CNT_HI ||
-                                w[41:32] == {6'h3F, 4'hF});
+                                w[41:32] == {OFF_SAVE, 4'hF});
     end
   endfunction
 
@@ -889,7 +890,7 @@ module enc_qei_engine_formal #(
   function [41:0] save_w;  // the write a store of f's COUNT_HI latch v puts in f's slot
     input [31:0] v;
     begin
-      save_w = {6'h3F, 4'hF, v};
+      save_w = {OFF_SAVE, 4'hF, v};
     end
   endfunction
 
@@ -1011,7 +1012,7 @@ module enc_qei_engine_formal #(
         f_svf <= 1'b0;
         f_svt <= 1'b1;
       end
-      if (f_wbv && p_slot == W_HI && f_hk && f_hx[41:36] == 6'h3F) begin
+      if (f_wbv && p_slot == W_HI && f_hk && f_hx[41:36] == OFF_SAVE) begin
         f_mlat <= f_hx[31:0];
         f_svt  <= 1'b0;
       end
@@ -1083,15 +1084,15 @@ module enc_qei_engine_formal #(
       if (|((p_pend | p_busy) & (1 << f_ch))) assert (slot_ok(p_slot_pk[41:0], f_pk, f_px));
       // (a state write: none of them but COUNT_HI and a store of f's latch)
       if (|((p_pend | p_busy) & p_pend_st & (1 << f_ch)))
-        assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == 6'h3F);
+        assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == OFF_SAVE);
       if (|((p_pend | p_busy) & ~p_pend_st & (1 << f_ch)))
-        assert (!f_pk || (f_px[41:36] != OFF_CNT_HI && f_px[41:36] != 6'h3F));
+        assert (!f_pk || (f_px[41:36] != OFF_CNT_HI && f_px[41:36] != OFF_SAVE));
       if (p_cn == f_ch && p_slot >= 5'd11 && p_n_taken) assert (slot_ok(p_n_pend, f_pk, f_px));
       if (p_cp == f_ch) begin
         assert (p_p_taken ? slot_ok(p_p_pend, f_lk, f_lx) : !f_lk);
-        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == 6'h3F);
+        if (p_slot >= V - 2 && p_e_taken) assert (!f_pk || f_px[41:36] == OFF_CNT_HI || f_px[41:36] == OFF_SAVE);
         if (p_slot == V - 1 && p_e_taken) assert (slot_ok(p_e_pend, f_pk, f_px));
-        if (p_p_taken && f_lk) assert (f_lx[41:36] != OFF_CNT_HI && f_lx[41:36] != 6'h3F);
+        if (p_p_taken && f_lk) assert (f_lx[41:36] != OFF_CNT_HI && f_lx[41:36] != OFF_SAVE);
       end
       // the count word of f: written whole in slot 0 of each of f's write-backs (always pending)
       stored_word(a_cnt, 5'd0, 1'b1, f_new, m_cnt, f_sto, p_n_cnt, 1'b1);
@@ -1122,11 +1123,11 @@ module enc_qei_engine_formal #(
       if (f_wbv) begin
         if (p_slot <= 5'd19) assert (p_ip_fresh == f_fresh);
         assert (p_ip_pre == {f_lk && f_lx[41:36] == OFF_PRE_HI, f_lk && f_lx[41:36] == OFF_PRE});
-        assert (p_ip_hi == {f_hk && f_hx[41:36] == OFF_CNT_HI, f_hk && f_hx[41:36] == 6'h3F});
-        if (f_hk) assert ((f_hx[41:36] == OFF_CNT_HI || f_hx[41:32] == {6'h3F, 4'hF}) && !f_lk);
+        assert (p_ip_hi == {f_hk && f_hx[41:36] == OFF_CNT_HI, f_hk && f_hx[41:36] == OFF_SAVE});
+        if (f_hk) assert ((f_hx[41:36] == OFF_CNT_HI || f_hx[41:32] == {OFF_SAVE, 4'hF}) && !f_lk);
         if (|p_ip_hi) assert (p_ip_data == f_hx[31:0] && p_ip_lanes == lanes_of(f_hx[35:32]));
         assert (f_stage == ((p_slot > W_HI && f_hk) ? stage_merge(f_vstage, f_hx) : f_vstage));
-        assert (f_mlat == ((p_slot > W_HI && f_hk && f_hx[41:36] == 6'h3F) ? f_hx[31:0] : f_vmlat));
+        assert (f_mlat == ((p_slot > W_HI && f_hk && f_hx[41:36] == OFF_SAVE) ? f_hx[31:0] : f_vmlat));
         assert (p_ip_ceil == {f_lk && f_lx[41:36] == OFF_CEIL_HI, f_lk && f_lx[41:36] == OFF_CEIL});
         if (|p_ip_pre || |p_ip_ceil)
           assert (p_ip_data == f_lx[31:0] && p_ip_lanes == lanes_of(f_lx[35:32]));
@@ -1178,8 +1179,8 @@ module enc_qei_engine_formal #(
       // last COUNT_LO read of f took it; when it is not, that word is being stored (f_svf: the
       // write is posted, in f's slot or taken by f's visit) or is the stored one
       if (COUNT_W <= 32)  // (COUNT_HI reads 0; no latch, nothing stored)
-        assert (!f_lat && !f_svf && !f_svt && f_mlat == 32'd0 && !(f_pk && f_px[41:36] == 6'h3F) &&
-                !(f_hk && f_hx[41:36] == 6'h3F));
+        assert (!f_lat && !f_svf && !f_svt && f_mlat == 32'd0 && !(f_pk && f_px[41:36] == OFF_SAVE) &&
+                !(f_hk && f_hx[41:36] == OFF_SAVE));
       if (COUNT_W > 32) begin
         if (p_cn == f_ch && p_slot >= 5'd11) assert (p_n_hi == {f_stage, f_mlat});
         if (p_cp == f_ch && p_slot >= 5'd17) assert (p_o_hi == {f_stage, f_mlat});
@@ -1191,8 +1192,8 @@ module enc_qei_engine_formal #(
         // (a store of f's latch: posted, in f's slot or taken at f's visit (f_svf), then in f's
         // write-back until slot 8 writes it (f_svt))
         if (f_save1 && f_save_ch == f_ch) assert (f_svf);
-        if ((p_pend[f_ch] || (p_busy[f_ch] && p_cp == f_ch)) && f_pk && f_px[41:36] == 6'h3F) assert (f_svf);
-        if (f_wbv && p_slot <= W_HI && f_hk && f_hx[41:36] == 6'h3F) assert (f_svt);
+        if ((p_pend[f_ch] || (p_busy[f_ch] && p_cp == f_ch)) && f_pk && f_px[41:36] == OFF_SAVE) assert (f_svf);
+        if (f_wbv && p_slot <= W_HI && f_hk && f_hx[41:36] == OFF_SAVE) assert (f_svt);
         if (f_svf) begin
           assert (f_lat && f_pk && f_px == save_w(f_latv));
           assert ((f_save1 && f_save_ch == f_ch) || p_pend[f_ch] || (p_busy[f_ch] && p_cp == f_ch));
