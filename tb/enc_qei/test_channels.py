@@ -124,7 +124,7 @@ async def independent_walks(dut):
                 model.dir = 1 if up else -1
             assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
             assert up == (model.dir > 0), f"{what}: STATUS.DIR {up}, model direction {model.dir}"
-            latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
+            latch = await env.bus.get64("INDEX_LATCH")
             assert latch == model.idx_latch, \
                 f"channel {k}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
     dut._log.info("final counts: %s", [hex(m.count) for m in models])
@@ -549,7 +549,7 @@ async def enable_overflow_glitches_per_channel(dut):
         for k, (env, model) in enumerate(pairs):
             assert model.idx_hits == 1, f"channel {k}: {model.idx_hits} index pulses played, not 1"
             await env.check(model, f"channel {k}: index {action} near {near}, steps {step:+d}")
-            latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
+            latch = await env.bus.get64("INDEX_LATCH")
             assert latch == model.idx_latch, f"channel {k}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
             await env.bus.wr("INDEX_CTRL", 0)
             model.idx_action = "none"

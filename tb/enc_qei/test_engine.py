@@ -307,7 +307,7 @@ async def check_final(env, model, k, pins_pos):
     ev.discard("SNAP_READY")
     exp = model.take_events()
     assert ev == exp, f"{what}: EVENTS {sorted(ev)}, model {sorted(exp)}"
-    latch = await env.bus.rd("INDEX_LATCH_LO") | await env.bus.rd("INDEX_LATCH_HI") << 32
+    latch = await env.bus.get64("INDEX_LATCH")
     assert latch == model.idx_latch, f"{what}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
     st = await env.bus.rd("STATUS")
     ab = (st >> field("STATUS", "A").lsb & 1, st >> field("STATUS", "B").lsb & 1)

@@ -65,7 +65,7 @@ async def index(dut):
             wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
             await env.play(wf, model, zfun=zf)
             await env.check(model, f"index {case}")
-            latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+            latch = await bus.get64("INDEX_LATCH")
             assert latch == model.idx_latch, f"{case}: INDEX_LATCH {latch}, model {model.idx_latch}"
             arm = (await bus.rd("INDEX_CTRL")) >> regmap()["INDEX_CTRL"].fields["ARM"].lsb & 1
             assert arm == int(model.idx_arm), f"{case}: INDEX_CTRL.ARM {arm}, model {model.idx_arm}"
@@ -158,7 +158,7 @@ async def latches_wide(dut):
             if probe:
                 got = await bus.rd("PROBE_LATCH_LO") | await bus.rd("PROBE_LATCH_HI") << 32
                 assert got == value, f"PROBE_LATCH {got:#x}, count {value:#x}"
-            index = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+            index = await bus.get64("INDEX_LATCH")
             assert index == value, f"INDEX_LATCH {index:#x}, count {value:#x}"
             await ClockCycles(dut.clk, gap) if gap else None
         await bus.wr("PROBE_CTRL", 0)
@@ -185,7 +185,7 @@ async def index_gate_each_state(dut):
             await play_clocks(env, model, step_clocks(env.pos, (1, 0, 0, 0), (0, 0, 1, 0)))
             await env.settle(4)
             await env.check(model, f"gate {gate}, Z pulse in state {QUAD[env.pos % 4]}")
-            latch = await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+            latch = await bus.get64("INDEX_LATCH")
             assert latch == model.idx_latch, \
                 f"gate {gate}, Z in {QUAD[env.pos % 4]}: INDEX_LATCH {latch:#x}, model {model.idx_latch:#x}"
     await bus.wr("INDEX_CTRL", 0)
@@ -310,7 +310,7 @@ async def ctrl_change_is_not_an_index_edge(dut):
     await bus.set64("PRESET", preset)
 
     async def latch():
-        return await bus.rd("INDEX_LATCH_LO") | await bus.rd("INDEX_LATCH_HI") << 32
+        return await bus.get64("INDEX_LATCH")
 
     def ctrl(option, value):
         return pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1, **{option: value})

@@ -141,6 +141,11 @@ class QeiBus:
         await self.wr("COUNT_HI", value >> 32 & 0xFFFFFFFF)
         await self.wr("COUNT_LO", value & 0xFFFFFFFF)
 
+    async def get64(self, base: str) -> int:
+        """A 64-bit register pair, {base}_LO then {base}_HI."""
+        lo = await self.rd(f"{base}_LO")
+        return await self.rd(f"{base}_HI") << 32 | lo
+
     async def set64(self, base: str, value: int) -> None:
         await self.wr(f"{base}_LO", value & 0xFFFFFFFF)
         await self.wr(f"{base}_HI", value >> 32 & 0xFFFFFFFF)
