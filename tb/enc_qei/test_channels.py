@@ -616,6 +616,39 @@ async def index_right_after_preset_writes(dut):
 
 
 @cocotb_test()
+async def index_presets_next_to_low_bit_wraps(dut):
+    """Index presets of a PRESET in the middle of the range whose low 16 bits are 0x0001 (then
+    four steps down) or 0xFFFE (four steps up), so the count's low bits wrap two steps after the
+    preset; the index at every phase of the shared engine's visits (every 8 clocks over P + 24),
+    on channel 0: COUNT and EVENTS as the model's (no UNDERFLOW, no OVERFLOW). The lane counts
+    the count's low bits and takes where the full count is from the validity set of its last
+    anchor, here the PRESET's (the ends of the range out of reach); the set of another anchor
+    (CEILING's: all ones, an end in reach) would call that wrap of the low bits the end of the
+    range, in the window up to the engine's next read."""
+    envs, rng = await start_channels(dut)
+    env = envs[0]
+    model = QeiModel(env.count_w)
+    span = engine_period(len(envs)) + 24 if engine_build() else 24
+    mid = (model.max + 1) >> 1
+    await env.setup(model, count=0x1000, filter_len=1)
+    for preset, step in ((mid + 1, -1), (mid - 2, 1)):
+        await env.bus.set64("PRESET", preset)
+        await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+        model.idx_gate, model.idx_oneshot = None, False
+        for j in range(0, span, 8):
+            await env.bus.set_count(0x1000)
+            model.write_count(0x1000)
+            await env.settle()
+            await ClockCycles(dut.clk, j)
+            start = env.pos
+            await env.play(walk([step] * 4, [3 * T_NS] * 4, start_pos=start), model,
+                           zfun=lambda p: int(p == start))
+            await env.check(model, f"an index preset of {preset:#x} {j} clocks after a COUNT write's "
+                                   f"answer, then 4 steps {'up' if step > 0 else 'down'}")
+
+
+@cocotb_test()
 async def presets_ranges_periods_per_channel(dut):
     """Per channel, through its own page and pins, what the shared engine keeps per channel and
     hands to each lane: index presets of PRESET with every low bit both ways (two PRESETs, one
