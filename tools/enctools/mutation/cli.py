@@ -110,6 +110,10 @@ def parse_args(argv=None):
     ap.add_argument("-n", type=int, default=None, help="mutants per module and corner "
                     "(default: the module's own, 25)")
     ap.add_argument("--only", default="", help="just these modules (comma-separated)")
+    ap.add_argument("--corner", action="append", default=[], metavar="LABEL",
+                    help="just this corner (repeatable; its label as --list prints it, e.g. "
+                    "'CHANNELS=3'): a long module's corners in runs of their own, joined by "
+                    "--report --results")
     ap.add_argument("--list", action="store_true",
                     help="discover and print the corners and their tests; run nothing")
     ap.add_argument("--keep", action="store_true",
@@ -153,10 +157,10 @@ def parse_args(argv=None):
 
 def command_of(args) -> str:
     """The command line a table names (what reruns it)."""
-    if not (args.only or args.n or args.table != "mutation"):
+    if not (args.only or args.corner or args.n or args.table != "mutation"):
         return "make mutate"
     parts = ["scripts/mutate.py"] + ([f"--only {','.join(args.only)}"] if args.only else []) + \
-        ([f"-n {args.n}"] if args.n else []) + \
+        [f"--corner '{c}'" for c in args.corner] + ([f"-n {args.n}"] if args.n else []) + \
         ([f"--table {args.table}"] if args.table != "mutation" else [])
     return " ".join(parts)
 
@@ -196,6 +200,13 @@ def main(argv=None) -> int:
     corners, notes = discover(root, modules, args.seed, say=lambda s: print(s, flush=True))
     for note in notes:
         print(f"  note: {note}", flush=True)
+    if args.corner:
+        unknown = [lb for lb in args.corner if not any(c.label == lb for c in corners)]
+        if unknown:
+            print(f"mutate: no corner {', '.join(repr(lb) for lb in unknown)}; the corners: "
+                  + "; ".join(f"{c.module} {c.label!r}" for c in corners), file=sys.stderr)
+            return 2
+        corners = [c for c in corners if c.label in args.corner]
     if args.list:
         for c in corners:
             n = args.n or c.spec.n

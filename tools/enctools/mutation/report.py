@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..paths import RESULTS, TOP
 from . import generate as gen
-from .data import KILLS, REVIEWED, Corner, Group, Module, Mutant, load_reviewed
+from .data import KILLS, REVIEWED, Corner, Group, Module, Mutant, load_reviewed, tag_of
 from .modules import MODULES
 
 RESULTS_MD = RESULTS / "mutation.md"
@@ -31,16 +31,25 @@ def save_results(root: Path, modules, corners, mutants, run: dict, notes: list[s
 
 
 def load_results(paths: list[Path]):
-    """Corners, mutants, modules, runs and notes of one or more results.json files. A module in
-    several of them is taken from the last one only (a module run again after tests were added
-    replaces its earlier run)."""
+    """Corners, mutants, modules, runs and notes of one or more results.json files. A corner (a
+    module's parameter set) in several of them is taken from the last one that has mutants there
+    (a corner run again after tests were added replaces its earlier run); a module's corners may
+    come from different runs (--corner)."""
     modules, corners, mutants, runs, notes = [], [], [], [], []
     datas = []
     for path in paths:
         if not path.exists():
             sys.exit(f"mutate --report: no {path}; run make mutate first")
         datas.append(json.loads(path.read_text()))
-    last = {m: i for i, data in enumerate(datas) for m in data["modules"]}
+    # (module, corner) -> (the run it is taken from, that run has mutants there): a run that
+    # generated none at a corner (a --mutation whose cell is not there) does not replace one that did
+    last: dict = {}
+    for i, data in enumerate(datas):
+        with_mutants = {m["corner"] for m in data["mutants"]}
+        for j, c in enumerate(data["corners"]):
+            key = (c["module"], tag_of(c["params"], c["defaults"]))
+            if j in with_mutants or not last.get(key, (0, False))[1]:
+                last[key] = (i, j in with_mutants)
     for i, data in enumerate(datas):
         gen.set_snapshot(Path(data["snapshot"]))
         cs = []
@@ -48,11 +57,11 @@ def load_results(paths: list[Path]):
             spec = MODULES.get(c["module"]) or Module("", ())
             cs.append(Corner(c["module"], spec.file, c["params"], c["defaults"],
                              [Group(**g) for g in c["groups"]], c["index"], spec, c["baseline_s"]))
-        keep = [last[c.module] == i for c in cs]
+        keep = [last[(c.module, c.tag)][0] == i for c in cs]
         mutants += [Mutant(cs[m["corner"]], m["number"], m["command"], Path(m["path"]),
                            m["result"], m["seconds"], m["failed_test"], m["eq_note"], m["opts"])
                     for m in data["mutants"] if keep[m["corner"]]]
-        modules += [m for m in data["modules"] if m not in modules and last[m] == i]
+        modules += [c.module for c, k in zip(cs, keep) if k and c.module not in modules]
         corners += [c for c, k in zip(cs, keep) if k]
         runs.append(data["run"])
         notes += data.get("notes", [])
