@@ -649,6 +649,60 @@ async def index_presets_next_to_low_bit_wraps(dut):
 
 
 @cocotb_test()
+async def first_snapshot_after_reset(dut):
+    """After rst (and again after a second rst, the pins where the walks left them), channel k
+    walks 5 + 7 k steps, up on even channels and down on odd ones, with no snapshot before: the
+    first global snapshot's SNAP_DELTA on channel k is exactly those steps (the motion since rst;
+    signed) and its SNAP_COUNT the count. Every channel walks its own number of steps, so a
+    motion that starts from the same wrong value on every channel does not hide behind equal
+    deltas."""
+    envs, rng = await start_channels(dut)
+    bus = envs[0].bus
+    for rnd in range(2):
+        if rnd:  # rst, every channel's pins where its walk left them
+            await pulse_rst(dut, clocks=4)
+        models = []
+        for k, env in enumerate(envs):
+            model = QeiModel(env.count_w)
+            await env.setup(model, count=0, filter_len=1)
+            models.append(model)
+        for k, (env, model) in enumerate(zip(envs, models)):
+            n = 5 + 7 * k
+            await env.play(walk([1 if k % 2 == 0 else -1] * n, [3 * T_NS] * n, start_pos=env.pos), model)
+        await env.settle()
+        await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
+        await ClockCycles(dut.clk, envs[0].lag)
+        for k, (env, model, snap) in enumerate(zip(envs, models, await read_all(envs))):
+            n = 5 + 7 * k
+            want = n if k % 2 == 0 else (-n) & 0xFFFF_FFFF
+            what = f"round {rnd}, channel {k}: the first snapshot after rst, {n} steps " \
+                   f"{'up' if k % 2 == 0 else 'down'}"
+            assert snap["SNAP_DELTA"] == want, f"{what}: SNAP_DELTA {snap['SNAP_DELTA']:#x}, steps {want:#x}"
+            count = (snap["SNAP_COUNT_HI"] << 32 | snap["SNAP_COUNT_LO"]) & model.max
+            assert count == model.count, f"{what}: SNAP_COUNT {count:#x}, model {model.count:#x}"
+
+
+@cocotb_test()
+async def count_writes_out_of_reach_then_across_the_ends(dut):
+    """Per channel: a COUNT write to R + 40 + k (R: the steps the shared engine's validity sets
+    describe, 2 P + 4; 300 without the engine), then R + 60 + k steps down across 0 (UNDERFLOW),
+    and a COUNT write to max - (R + 40 + k), then as many steps up across the top (OVERFLOW):
+    COUNT and EVENTS as the model's. The lane counts the count's low bits; the write's set says the
+    ends are out of reach, and the sets of the reads that follow, as the count comes near, say
+    where the end is: a lane that kept the write's set would miss the end."""
+    envs, rng = await start_channels(dut)
+    reach = 2 * engine_period(len(envs)) + 4 if engine_build() else 300
+    for k, env in enumerate(envs):
+        model = QeiModel(env.count_w)
+        for start, step in ((reach + 40 + k, -1), (model.max - (reach + 40 + k), 1)):
+            await env.setup(model, count=start, filter_len=1)
+            n = reach + 60 + k
+            await env.play(walk([step] * n, [3 * T_NS] * n, start_pos=env.pos), model)
+            await env.check(model, f"channel {k}: COUNT written {start:#x}, then {n} steps "
+                                   f"{'up' if step > 0 else 'down'}")
+
+
+@cocotb_test()
 async def presets_ranges_periods_per_channel(dut):
     """Per channel, through its own page and pins, what the shared engine keeps per channel and
     hands to each lane: index presets of PRESET with every low bit both ways (two PRESETs, one
