@@ -652,8 +652,8 @@ async def index_presets_next_to_low_bit_wraps(dut):
 async def first_snapshot_after_reset(dut):
     """After rst (and again after a second rst, the pins where the walks left them), channel k
     walks 5 + 7 k steps, up on even channels and down on odd ones, with no snapshot before: the
-    first global snapshot's SNAP_DELTA on channel k is exactly those steps (the motion since rst;
-    signed) and its SNAP_COUNT the count. Every channel walks its own number of steps, so a
+    first global snapshot's SNAP_DELTA and SNAP_EDGE_DELTA (EDGE any, from rst) on channel k are
+    exactly those steps (the motion since rst; signed) and its SNAP_COUNT the count. Every channel walks its own number of steps, so a
     motion that starts from the same wrong value on every channel does not hide behind equal
     deltas."""
     envs, rng = await start_channels(dut)
@@ -678,6 +678,9 @@ async def first_snapshot_after_reset(dut):
             what = f"round {rnd}, channel {k}: the first snapshot after rst, {n} steps " \
                    f"{'up' if k % 2 == 0 else 'down'}"
             assert snap["SNAP_DELTA"] == want, f"{what}: SNAP_DELTA {snap['SNAP_DELTA']:#x}, steps {want:#x}"
+            # (SNAP_CTRL.EDGE = any from rst: the last selected edge is the last step)
+            assert snap["SNAP_EDGE_DELTA"] == want, \
+                f"{what}: SNAP_EDGE_DELTA {snap['SNAP_EDGE_DELTA']:#x}, steps {want:#x}"
             count = (snap["SNAP_COUNT_HI"] << 32 | snap["SNAP_COUNT_LO"]) & model.max
             assert count == model.count, f"{what}: SNAP_COUNT {count:#x}, model {model.count:#x}"
 
