@@ -749,7 +749,8 @@ module enc_qei_lane #(
       reg [TIM_W-1:0] bf_q, bt_q, bt0_q;
       reg             bdir_q;
       wire            per_en = cfg_q[C_PER_EN];
-      wire            plast  = (pcnt_q == cfg_q[C_PER_N +: C_PER_N_W]);
+      // (at or above N - 1: a lower N ends the measurement in progress at its next edge)
+      wire            plast  = (pcnt_q >= cfg_q[C_PER_N +: C_PER_N_W]);
       wire            pstart = per_en & psel_q & ~pst_q;          // the first edge after EN
       wire            pbound = per_en & psel_q & pst_q & plast;   // every N-th one after it
       wire            pany_q = (nb_q != 2'd0) | bst_q;            // one of them in the window

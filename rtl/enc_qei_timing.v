@@ -24,7 +24,8 @@
 // wrap (2^31 steps between two snapshots).
 // Period: while period_en, every period_n (0 acts as 1) selected edges the ticks since the edge
 // that started the measurement go to PERIOD (timebase(end) - timebase(start)); the end edge starts
-// the next one. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
+// the next one. A period_n lowered below the edges the measurement in progress has counted ends
+// it at its next selected edge. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
 // event when it saturates); the direction-change flag is set by a count step against the
 // previous one inside the measurement (the start edge's own excluded, the end edge's included).
 // Stall: no count step of the count function for stall_timeout ticks (0: off) raises the stall
@@ -242,17 +243,20 @@ module enc_qei_timing #(
       per_last_zero_q <= (per_last_d == 8'd0);
     end
 
-    reg n_last_d;  // n_d == per_last_q
+    // n_last_d: n_d >= per_last_q. At or above, not equal: a write that lowers N below the edges
+    // the measurement in progress has counted ends it at the next selected edge (with == it ran
+    // on until n_q wrapped, 256 edges)
+    reg n_last_d;
 
     always @(*) begin
       if (!period_en) begin
-        n_last_d = (n_q == per_last_q);
+        n_last_d = (n_q >= per_last_q);
       end else if (sel_per & (~started_q | n_last)) begin
         n_last_d = per_last_zero_q;
       end else if (started_q & sel_per) begin
-        n_last_d = (n_q == per_last_m1_q);
+        n_last_d = per_last_zero_q | (n_q >= per_last_m1_q);  // (n_q + 1 >= N - 1)
       end else begin
-        n_last_d = (n_q == per_last_q);
+        n_last_d = (n_q >= per_last_q);
       end
     end
 
