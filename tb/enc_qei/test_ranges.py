@@ -321,6 +321,27 @@ async def range_change_across_the_wrap(dut):
     await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1))
 
 
+@cocotb_test(skip=lacks("RANGE"))
+async def ranges_beside_index_options(dut):
+    """RANGE modulo and limit with CEILING 20 and 21 while INDEX_CTRL holds options without an
+    action (ONESHOT; the gate on A and B; EDGE falling with ARM): up across CEILING and down across
+    0, COUNT and EVENTS as the model's. The channel's configuration travels as one word; a bit of
+    CEILING taken wrong while an unrelated bit of it is set shows only at CEILING's own ends."""
+    env, rng = await begin(dut)
+    model = QeiModel(env.count_w)
+    bus = env.bus
+    for opts in (dict(ONESHOT=1), dict(GATE_EN=1, GATE_A=1, GATE_B=1), dict(EDGE="falling", ARM=1)):
+        for mode, ceiling in (("modulo", 20), ("limit", 21), ("modulo", 21), ("limit", 20)):
+            await env.setup(model, rng_mode=mode, count=ceiling - 3, ceiling=ceiling, filter_len=1)
+            await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", **opts))
+            await env.applied()
+            for direction, n in ((1, 6), (-1, 28), (1, 5)):
+                wf = walk([direction] * n, [3 * T_NS] * n, start_pos=env.pos)
+                await env.play(wf, model)
+                await env.check(model, f"INDEX_CTRL {opts}, {mode} CEILING {ceiling}, {n} steps "
+                                       f"{'up' if direction > 0 else 'down'}")
+            await bus.wr("INDEX_CTRL", 0)
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
 def test_ranges(config):

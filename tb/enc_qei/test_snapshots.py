@@ -398,6 +398,39 @@ async def snapshot_deltas_held(dut):
 
 
 @cocotb_test()
+async def snapshot_edge_time_long_after_the_edge(dut):
+    """Five steps, a snapshot, then snapshots 1,061, 2,122 and 5,305 clocks later with the shaft
+    at rest (EDGE any, PRESCALE 0): SNAP_EDGE_TIME stays the last step's time, SNAP_DELTA and
+    SNAP_EDGE_DELTA are 0, SNAP_TIME moves on. The shared engine's lane keeps only the low bits of
+    an edge's time (256 ticks at one channel); the engine takes them in the window of the edge
+    only: rebuilt from them later, an old edge's time would move forward by a multiple of 256."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=1000, filter_len=1)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE="any"))
+    await env.applied()
+    await env.play(walk([1] * 5, [3 * T_NS] * 5, start_pos=env.pos), model)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+    await env.settle(4)
+    first = await read_snapshot(bus)
+    last_time = first["time"]
+    for rest in (1061, 2122, 5305):
+        await ClockCycles(dut.clk, rest)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        snap = await read_snapshot(bus)
+        what = f"a snapshot {rest} clocks after the one after the last step"
+        assert snap["time"] != last_time, f"{what}: SNAP_TIME {snap['time']:#x} did not move"
+        assert snap["edge_time"] == first["edge_time"], \
+            f"{what}: SNAP_EDGE_TIME {snap['edge_time']:#x}, the last step's {first['edge_time']:#x}"
+        assert snap["delta"] == 0 and snap["edge_delta"] == 0, \
+            f"{what}: SNAP_DELTA {snap['delta']:#x}, SNAP_EDGE_DELTA {snap['edge_delta']:#x}, not 0"
+        last_time = snap["time"]
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
 async def snapshot_edge_delta_after_reversal(dut):
     """SNAP_CTRL.EDGE = A rising: a snapshot taken after steps back behind the last rising edge of
     A (steps counted since that edge go down from a positive value), then walks forward through

@@ -76,14 +76,16 @@ async def prescaler_and_snap_in(dut):
 
 @cocotb_test(skip=lacks("PERIOD"))
 async def period_capture(dut):
-    """PERIOD over N edges at constant speed, the direction-change flag, PERIOD_READY, and the
-    overflow flag and PERIOD_OVF event (TS_W = 16 builds only: 65,536 ticks)."""
+    """PERIOD over N edges at constant speed (measurements of an even and of an odd number of
+    clocks), the direction-change flag, PERIOD_READY, and the overflow flag and PERIOD_OVF event
+    (TS_W = 16 builds only: 65,536 ticks)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
     await env.setup(model, count=0, filter_len=1)
     lsb = regmap()["PERIOD_CTRL"].fields
-    for edge, n, d in (("any", 4, 7), ("any", 1, 12), ("a_rising", 2, 5)):
+    # (measurements of an even and an odd number of clocks: 28, 12, 40; 9, 15)
+    for edge, n, d in (("any", 4, 7), ("any", 1, 12), ("a_rising", 2, 5), ("any", 1, 9), ("any", 3, 5)):
         await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE=edge, N=n))
         await env.applied()
         # states of exactly d clocks: every edge interval is d clocks
@@ -123,6 +125,38 @@ async def period_capture(dut):
     else:
         dut._log.info("TS_W = %d: period overflow is checked in the TS_W = 16 build", int(dut.TS_W.value))
     await bus.wr("PERIOD_CTRL", 0)
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def period_n_lowered_mid_measurement(dut):
+    """PERIOD_CTRL.N lowered from 8 to 2 after the measurement in progress has counted 5 edges
+    (states of 10 clocks, EDGE any): it ends at its next edge (PERIOD_READY within 4 edges, not
+    after the edge counter wraps), and the next PERIOD spans the new N (20 ticks). Then N raised
+    from 2 to 6 the same way: PERIOD 60."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    d = 10
+    for first, second in ((8, 2), (2, 6)):
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=first))
+        await env.applied()
+        await env.play(walk([1] * (first + 6), [d * T_NS] * (first + 6), start_pos=env.pos), None)
+        await env.play(walk([1] * 5, [d * T_NS] * 5, start_pos=env.pos), None)  # 5 edges into one
+        await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=second))
+        await env.applied()
+        await bus.events()
+        await env.play(walk([1] * 4, [d * T_NS] * 4, start_pos=env.pos), None)
+        await env.settle()
+        if second < first:
+            assert "PERIOD_READY" in await bus.events(), \
+                f"N {first} -> {second} after 5 edges: no PERIOD_READY in the next 4 edges"
+        await env.play(walk([1] * (2 * second + 2), [d * T_NS] * (2 * second + 2), start_pos=env.pos), None)
+        await env.settle()
+        period = await bus.rd("PERIOD")
+        assert period == second * d, f"N {first} -> {second}: PERIOD {period}, expected {second * d}"
+    await bus.wr("PERIOD_CTRL", 0)
+    await env.applied()
+    await bus.events()
 
 
 @cocotb_test(skip=lacks("PERIOD"))
@@ -240,6 +274,41 @@ async def stall_timeout_exact(dut):
     await bus.wr("STALL_TIMEOUT", 0)
     await bus.wr("TB_PRESCALE", 0)
     await bus.wr("IRQ_EN", 0)
+    await bus.events()
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def stall_with_a_slow_prescaler(dut):
+    """STALL_TIMEOUT 3 at TB_PRESCALE 255 (a tick every 256 clocks): the stall comes at the third
+    tick after a step. Steps 505 clocks apart hold one or two ticks between them, never three,
+    whatever the prescaler's phase: no STALL. Then pauses of 790 clocks (three ticks or more):
+    a STALL in each. A stall raised as soon as the tick count reached STALL_TIMEOUT - 1 (not at the
+    tick that makes it STALL_TIMEOUT) comes 1 to 256 clocks early, inside the 505."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    await bus.wr("TB_PRESCALE", 255)
+    await bus.wr("STALL_TIMEOUT", 3)
+    await env.applied()
+    await step_forward(env)
+    await env.settle(3)
+    await bus.events()  # (a stall of the rest before the first step)
+    for i in range(8):
+        await ClockCycles(dut.clk, 505)
+        await step_forward(env)
+    await env.settle(3)
+    ev = await bus.events()
+    assert "STALL" not in ev, f"STALL with steps 505 clocks apart (two ticks at most; EVENTS {sorted(ev)})"
+    for i in range(3):
+        await ClockCycles(dut.clk, 790)
+        await env.settle(3)
+        ev = await bus.events()
+        assert "STALL" in ev, f"pause {i}: no STALL 790 clocks after a step (three ticks; EVENTS {sorted(ev)})"
+        await step_forward(env)
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("TB_PRESCALE", 0)
+    await env.applied()
     await bus.events()
 
 

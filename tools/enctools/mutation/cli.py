@@ -172,6 +172,8 @@ def report_again(args) -> int:
              else [gen.BUILD_REL / (args.work or f"seed{args.seed}") / "results.json"])
     paths = [p if p.is_absolute() else TOP / p for p in paths]
     modules, corners, mutants, runs, notes = load_results(paths)
+    if not args.only and set(modules) != set(MODULES):  # (the table names the run's modules)
+        args.only = list(modules)
     run = dict(runs[-1])
     run["elapsed"] = sum(r["elapsed"] for r in runs)
     run["cpu"] = sum(r.get("cpu", 0) for r in runs)
