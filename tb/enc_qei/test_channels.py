@@ -48,6 +48,16 @@ async def start_channels(dut):
     return channel_envs(dut, rng, channels_of(dut)), rng
 
 
+async def arm_index_preset(env, model, preset: int, oneshot: bool = False) -> None:
+    """PRESET and INDEX_CTRL for an index preset on the rising edge (ARM), in the channel and in
+    its model."""
+    await env.bus.set64("PRESET", preset)
+    await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1,
+                                        ONESHOT=int(oneshot)))
+    model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+    model.idx_gate, model.idx_oneshot = None, oneshot
+
+
 async def set_index(env, model, rng) -> None:
     """A random INDEX_CTRL action on one channel (and its model)."""
     action = rng.choice(("none", "preset", "latch"))
@@ -599,10 +609,7 @@ async def index_right_after_preset_writes(dut):
     span = engine_period(len(envs)) + 24 if engine_build() else 24
     preset = model.max - 5
     await env.setup(model, count=0x1000, filter_len=1)
-    await env.bus.set64("PRESET", preset)
-    await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
-    model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
-    model.idx_gate, model.idx_oneshot = None, False
+    await arm_index_preset(env, model, preset)
     for j in range(0, span, 8):
         await env.bus.set_count(0x1000)
         model.write_count(0x1000)
@@ -632,10 +639,7 @@ async def index_presets_next_to_low_bit_wraps(dut):
     mid = (model.max + 1) >> 1
     await env.setup(model, count=0x1000, filter_len=1)
     for preset, step in ((mid + 1, -1), (mid - 2, 1)):
-        await env.bus.set64("PRESET", preset)
-        await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
-        model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
-        model.idx_gate, model.idx_oneshot = None, False
+        await arm_index_preset(env, model, preset)
         for j in range(0, span, 8):
             await env.bus.set_count(0x1000)
             model.write_count(0x1000)
@@ -721,11 +725,7 @@ async def presets_ranges_periods_per_channel(dut):
         await env.setup(model, count=rng.getrandbits(16), filter_len=1)
         for value, oneshot in ((0xA5C3_5A3C ^ k, False), (0x5A3C_A5C3 ^ k, False), (0x1234_5678 + k, True)):
             value &= model.max
-            await env.bus.set64("PRESET", value)
-            await env.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1,
-                                                ONESHOT=int(oneshot)))
-            model.preset, model.idx_action, model.idx_edge, model.idx_arm = value, "preset", "rising", True
-            model.idx_gate, model.idx_oneshot = None, oneshot
+            await arm_index_preset(env, model, value, oneshot)
             await env.applied()
             # an index pulse two steps in, another five steps later (the one-shot takes the first)
             marks = (env.pos + 2, env.pos + 7)
