@@ -25,9 +25,10 @@
 // Period: while period_en, every period_n (0 acts as 1) selected edges the ticks since the edge
 // that started the measurement go to PERIOD (timebase(end) - timebase(start)); the end edge starts
 // the next one. A period_n lowered below the edges the measurement in progress has counted ends
-// it at its next selected edge. The measurement's tick count saturates at all ones (overflow flag, PERIOD_OVF
-// event when it saturates); the direction-change flag is set by a count step against the
-// previous one inside the measurement (the start edge's own excluded, the end edge's included).
+// it at its next selected edge. The measurement's tick count saturates at all ones (overflow
+// flag, PERIOD_OVF event when it saturates); the direction-change flag is set by a count step
+// against the previous one inside the measurement (the start edge's own excluded, the end edge's
+// included).
 // Stall: no count step of the count function for stall_timeout ticks (0: off) raises the stall
 // event once and sets `stalled` until the next step.
 // PERIOD = 0 (PROFILE lean) leaves period capture and stall detection out: their outputs are 0.
@@ -244,8 +245,8 @@ module enc_qei_timing #(
     end
 
     // n_last_d: n_d >= per_last_q. At or above, not equal: a write that lowers N below the edges
-    // the measurement in progress has counted ends it at the next selected edge (with == it ran
-    // on until n_q wrapped, 256 edges)
+    // the measurement in progress has counted ends it at the next selected edge (an equality
+    // would miss the lowered N until n_q wraps, 256 edges later)
     reg n_last_d;
 
     always @(*) begin
