@@ -657,31 +657,29 @@ async def first_snapshot_after_reset(dut):
     """After rst (and again after a second rst, the pins where the walks left them), channel k
     walks 5 + 7 k steps, up on even channels and down on odd ones, with no snapshot before: the
     first global snapshot's SNAP_DELTA and SNAP_EDGE_DELTA (EDGE any, from rst) on channel k are
-    exactly those steps (the motion since rst; signed) and its SNAP_COUNT the count. Every channel walks its own number of steps, so a
-    motion that starts from the same wrong value on every channel does not hide behind equal
-    deltas."""
+    exactly those steps (the motion since rst; signed) and its SNAP_COUNT the count. Every
+    channel walks its own number of steps, so a motion that starts from the same wrong value on
+    every channel does not hide behind equal deltas."""
     envs, rng = await start_channels(dut)
     bus = envs[0].bus
+    moves = [(5 + 7 * k) * (1 if k % 2 == 0 else -1) for k in range(len(envs))]  # signed steps
     for rnd in range(2):
         if rnd:  # rst, every channel's pins where its walk left them
             await pulse_rst(dut, clocks=4)
-        models = []
-        for k, env in enumerate(envs):
-            model = QeiModel(env.count_w)
+        models = [QeiModel(env.count_w) for env in envs]
+        for env, model in zip(envs, models):
             await env.setup(model, count=0, filter_len=1)
-            models.append(model)
-        for k, (env, model) in enumerate(zip(envs, models)):
-            n = 5 + 7 * k
-            await env.play(walk([1 if k % 2 == 0 else -1] * n, [3 * T_NS] * n, start_pos=env.pos), model)
+        for env, model, m in zip(envs, models, moves):
+            n = abs(m)
+            await env.play(walk([1 if m > 0 else -1] * n, [3 * T_NS] * n, start_pos=env.pos), model)
         await env.settle()
         await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1))
         await ClockCycles(dut.clk, envs[0].lag)
-        for k, (env, model, snap) in enumerate(zip(envs, models, await read_all(envs))):
-            n = 5 + 7 * k
-            want = n if k % 2 == 0 else (-n) & 0xFFFF_FFFF
-            what = f"round {rnd}, channel {k}: the first snapshot after rst, {n} steps " \
-                   f"{'up' if k % 2 == 0 else 'down'}"
-            assert snap["SNAP_DELTA"] == want, f"{what}: SNAP_DELTA {snap['SNAP_DELTA']:#x}, steps {want:#x}"
+        for k, (model, m, snap) in enumerate(zip(models, moves, await read_all(envs))):
+            want = m & 0xFFFF_FFFF
+            what = f"round {rnd}, channel {k}: the first snapshot after rst, {m:+d} steps"
+            assert snap["SNAP_DELTA"] == want, \
+                f"{what}: SNAP_DELTA {snap['SNAP_DELTA']:#x}, steps {want:#x}"
             # (SNAP_CTRL.EDGE = any from rst: the last selected edge is the last step)
             assert snap["SNAP_EDGE_DELTA"] == want, \
                 f"{what}: SNAP_EDGE_DELTA {snap['SNAP_EDGE_DELTA']:#x}, steps {want:#x}"

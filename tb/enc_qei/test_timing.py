@@ -137,20 +137,24 @@ async def period_n_lowered_mid_measurement(dut):
     bus = env.bus
     await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
     d = 10
+
+    async def forward(n: int) -> None:  # n steps up, states of d clocks
+        await env.play(walk([1] * n, [d * T_NS] * n, start_pos=env.pos), None)
+
     for first, second in ((8, 2), (2, 6)):
         await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=first))
         await env.applied()
-        await env.play(walk([1] * (first + 6), [d * T_NS] * (first + 6), start_pos=env.pos), None)
-        await env.play(walk([1] * 5, [d * T_NS] * 5, start_pos=env.pos), None)  # 5 edges into one
+        await forward(first + 6)
+        await forward(5)  # 5 edges into one measurement
         await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=second))
         await env.applied()
         await bus.events()
-        await env.play(walk([1] * 4, [d * T_NS] * 4, start_pos=env.pos), None)
+        await forward(4)
         await env.settle()
         if second < first:
             assert "PERIOD_READY" in await bus.events(), \
                 f"N {first} -> {second} after 5 edges: no PERIOD_READY in the next 4 edges"
-        await env.play(walk([1] * (2 * second + 2), [d * T_NS] * (2 * second + 2), start_pos=env.pos), None)
+        await forward(2 * second + 2)
         await env.settle()
         period = await bus.rd("PERIOD")
         assert period == second * d, f"N {first} -> {second}: PERIOD {period}, expected {second * d}"
@@ -299,12 +303,14 @@ async def stall_with_a_slow_prescaler(dut):
         await step_forward(env)
     await env.settle(3)
     ev = await bus.events()
-    assert "STALL" not in ev, f"STALL with steps 505 clocks apart (two ticks at most; EVENTS {sorted(ev)})"
+    assert "STALL" not in ev, \
+        f"STALL with steps 505 clocks apart (two ticks at most; EVENTS {sorted(ev)})"
     for i in range(3):
         await ClockCycles(dut.clk, 790)
         await env.settle(3)
         ev = await bus.events()
-        assert "STALL" in ev, f"pause {i}: no STALL 790 clocks after a step (three ticks; EVENTS {sorted(ev)})"
+        assert "STALL" in ev, \
+            f"pause {i}: no STALL 790 clocks after a step (three ticks; EVENTS {sorted(ev)})"
         await step_forward(env)
     await bus.wr("STALL_TIMEOUT", 0)
     await bus.wr("TB_PRESCALE", 0)
