@@ -1,7 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """Is a surviving mutant equivalent to the original? Two Yosys stages, each with a CPU-time limit
-(a busy machine gives the same answer as an idle one).
+(a busy machine gives the same answer as an idle one), after a check that needs none.
 
+0. The mutant written alone (mNN.v) is the text of the unmutated design written the same way
+   (m00.v): the mutation set a bit to the constant it is already, and changed no cell. Equivalent
+   whatever the design; stage 1 cannot show it where ``equiv_make`` fails on the design (the
+   engine's memories).
 1. ``equiv_make`` (signals matched by name, both sides flattened), ``equiv_simple -seq 5``,
    ``equiv_induct -seq 5``, ``equiv_status -assert``: a proof holds from any state in which the
    matched signals agree, reset or not.
@@ -33,8 +37,20 @@ def _side(c, rel: str, name: str, mutate: str) -> str:
             f"rename {c.module} {name}\n")
 
 
+def unchanged(root: Path, m: Mutant) -> bool:
+    """Stage 0: the mutant written alone is the unmutated design's text (m00.v)."""
+    base = gen.corner_dir(root, m.corner) / "m00.v"
+    try:
+        gen.write_mutant(root, m)
+    except RuntimeError:
+        return False
+    return base.exists() and m.path.read_text() == base.read_text()
+
+
 def equivalence(root: Path, m: Mutant, miter: bool = True) -> tuple[bool, str]:
     """(proven equivalent, what the stages found)."""
+    if unchanged(root, m):
+        return True, "proven equivalent (written alone it is the unmutated netlist, m00.v)"
     c = m.corner
     d = gen.corner_dir(root, c)
     rel = gen.rel(d)
