@@ -174,6 +174,8 @@ def report_again(args) -> int:
     modules, corners, mutants, runs, notes = load_results(paths)
     if not args.only and set(modules) != set(MODULES):  # (the table names the run's modules)
         args.only = list(modules)
+    if not args.corner:  # and the corners its runs were limited to (--corner)
+        args.corner = list(dict.fromkeys(lb for r in runs for lb in r.get("corners", [])))
     run = dict(runs[-1])
     run["elapsed"] = sum(r["elapsed"] for r in runs)
     run["cpu"] = sum(r.get("cpu", 0) for r in runs)
@@ -309,7 +311,7 @@ def main(argv=None) -> int:
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)
     run = {"elapsed": time.monotonic() - t_start, "cpu": ru.ru_utime + ru.ru_stime,
            "jobs": args.jobs, "load": [round(x, 1) for x in load_start + os.getloadavg()],
-           "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+           "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "corners": args.corner}
     save_results(root, list(modules), corners, mutants, run, notes)
     return report(list(modules), corners, mutants, args.seed, run, notes, not args.no_results,
                   args.table, command_of(args))
