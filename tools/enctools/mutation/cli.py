@@ -135,6 +135,9 @@ def parse_args(argv=None):
     ap.add_argument("--results", default="", metavar="JSON[,JSON]",
                     help="with --report: these results.json files (runs of different modules) "
                     "as one table")
+    ap.add_argument("--recheck", action="store_true",
+                    help="with --report: equivalence stage 0 again on the survivors whose mNN.v "
+                    "and m00.v are still in the work directory (a run made before that stage)")
     ap.add_argument("--work", default="", metavar="NAME",
                     help="work directory build/mutate/NAME (default seed<S>)")
     args = ap.parse_args(argv)
@@ -150,6 +153,8 @@ def parse_args(argv=None):
         ap.error("--mutation needs exactly one module in --only")
     if args.mutation:
         args.no_results = True
+    if args.recheck and not args.report:
+        ap.error("--recheck goes with --report")
     if not re.fullmatch(r"[A-Za-z0-9_-]+", args.table):
         ap.error(f"--table {args.table!r}: a file name (letters, digits, _ and -), no path")
     return args
@@ -165,6 +170,13 @@ def command_of(args) -> str:
     return " ".join(parts)
 
 
+def written_unchanged(m) -> bool:
+    """Stage 0 on a recorded survivor: its mNN.v, as the run wrote it, is its corner's m00.v."""
+    p = m.path if m.path.is_absolute() else TOP / m.path
+    base = p.parent / "m00.v"
+    return p.exists() and base.exists() and p.read_text() == base.read_text()
+
+
 def report_again(args) -> int:
     """The table of earlier runs, from their results.json; several runs (of different modules)
     are summed into one table: wall and CPU time added, each run's load kept."""
@@ -172,6 +184,17 @@ def report_again(args) -> int:
              else [gen.BUILD_REL / (args.work or f"seed{args.seed}") / "results.json"])
     paths = [p if p.is_absolute() else TOP / p for p in paths]
     modules, corners, mutants, runs, notes = load_results(paths)
+    if args.recheck:
+        found = [m for m in mutants if m.result == "survived" and written_unchanged(m)]
+        for m in found:
+            m.result = "equivalent"
+            m.eq_note = ("proven equivalent (written alone it is the unmutated netlist, m00.v; "
+                         "found by --report --recheck)")
+        print(f"mutate --report --recheck: {len(found)} survivor(s) are the unmutated netlist"
+              + (": " + ", ".join(f"{m.corner.label} m{m.number:02d}" for m in found) if found else ""))
+        if found:
+            notes = notes + [f"equivalence stage 0 applied after the run (--report --recheck): "
+                             f"{len(found)} survivor(s) found equivalent"]
     if not args.only and set(modules) != set(MODULES):  # (the table names the run's modules)
         args.only = list(modules)
     if not args.corner:  # and the corners its runs were limited to (--corner)
