@@ -809,13 +809,20 @@ module enc_qei_engine #(
   end
 
   // ---- the visit's computation for c(v) (slot 23) ----------------------------------------------------------
-  // (channel 0's first visit, after rst: its lane as rst left it, at timebase 0)
+  // (channel 0's first visit, after rst: its lane as rst left it, at timebase 0: the record
+  // REC_RST, 0 but for the bits the lane resets to 1, INDEX_CTRL.ARM's reset value and STATUS.DIR,
+  // and PROBE_CTRL.EN's reset value; its first write-back stores them)
+  localparam [REC_W-1:0] REC_ONE = {{(REC_W-1){1'b0}}, 1'b1};
+  localparam [REC_W-1:0] REC_RST =
+      (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
+      (ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN] ? (REC_ONE << R_PEN) : {REC_W{1'b0}}) |
+      (REC_ONE << R_DIR);
   reg [REC_W-1:0] rec_q;      // c(v)'s record (its lane, in the clock of its read)
   reg [TS_W-1:0]  tv_q;       // the timebase in that clock
 
   always @(posedge clk) begin
     if (rst) begin
-      rec_q <= {REC_W{1'b0}};
+      rec_q <= REC_RST;
       tv_q  <= {TS_W{1'b0}};
     end else if (slot_q == S_LAST) begin
       rec_q <= rec_or;

@@ -17,7 +17,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import ENGINE_IRQ, CONFIG_IDS, CONFIGS, begin, engine_period, lacks, run_feature
+from enctools.qei.env import (ENGINE_IRQ, CONFIG_IDS, CONFIGS, Timebase, begin, engine_period, lacks,
+                              run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, play_clocks, step_clocks
 from enctools.regmap import event_bits, pack, regmap
@@ -457,6 +458,34 @@ async def period_held_after_disable(dut):
             assert period == d, f"EN {int(enabled)}: PERIOD {period:#x}, expected {d:#x}"
             if gap:
                 await ClockCycles(dut.clk, gap)
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def period_end_at_every_timebase_phase(dut):
+    """PERIOD of 0x500 ticks (more than 2^10) whose end edge comes at eight phases of the
+    timebase's low 12 bits, 0x200 apart (the edge's timebase bits 11:10 take every value twice):
+    exact every time, no OVERFLOW, no PERIOD_OVF. The shared engine rebuilds an end edge's time
+    from the timebase's low bits; a fault there shows only at some phases of the timebase."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    lsb = regmap()["PERIOD_CTRL"].fields
+    clock = Timebase(dut)
+    d = 0x500
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.applied()
+    for r in range(0, 0x1000, 0x200):
+        await bus.events()
+        await clock.phase(0x1000, r)
+        await env.play(walk([1, 1], [d * T_NS, d * T_NS], start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        ctrl = await bus.rd("PERIOD_CTRL")
+        events = await bus.events()
+        assert period == d, f"phase {r:#x}: PERIOD {period:#x}, expected {d:#x}"
+        assert not ctrl >> lsb["OVERFLOW"].lsb & 1, f"phase {r:#x}: PERIOD_CTRL.OVERFLOW set"
+        assert "PERIOD_OVF" not in events, f"phase {r:#x}: PERIOD_OVF raised"
+    await bus.wr("PERIOD_CTRL", 0)
 
 
 @cocotb_test(skip=lacks("PERIOD"))
