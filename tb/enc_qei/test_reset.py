@@ -14,7 +14,7 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, engine_lag, engine_period, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, engine_period, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, pulse_rst
 from enctools.regmap import built_mask, pack, regmap, units
@@ -182,42 +182,41 @@ async def irq_low_in_reset(dut):
         assert dut.irq.value == 0, f"irq high {k} clocks after the reset"
 
 
-@cocotb_test()
+@cocotb_test(timeout_time=12, timeout_unit="ms")  # about 3.6 ms on the engine: 3x, for mutation
 async def reset_values_right_after_reset(dut):
     """Every channel register reads its RDL reset value (of the build's units) from the first
-    clock after rst falls: for each register and each d, one reset and one read requested about
-    d clocks after it, d = 0 .. P + 7 on the shared engine (P: the clocks between two reads of a
+    clock after rst falls: for each d and each register, one reset and one read requested about d
+    clocks after it, d = 0 .. P + 7 on the shared engine (P: the clocks between two reads of a
     channel; the engine answers the reset values until its first write-back of the channel, in
     its second visit) and 0 .. 7 on a per_channel build. Before each reset the register is
     written another value where it has configuration fields, and a snapshot is taken
-    (SNAP_READY pending, SNAP_TIME set), and both are left time to be stored: a read answered
+    (SNAP_READY pending, SNAP_TIME set), and both are given time to be stored: a read answered
     from the state before the reset, or from a reset value with a wrong bit, shows."""
     env, rng = await begin(dut)
     bus = env.bus
     caps = await bus.rd("CAPS")
     count_w, ts_w, have = caps & 0xFF, caps >> 8 & 0xFF, units(caps)
-    channels = int(dut.CHANNELS.value)
-    span = engine_period(channels) + 8 if env.engine else 8
-    lag = engine_lag(channels) if env.engine else 4
-    regs = [r for r in sorted(regmap().values(), key=lambda r: r.offset)
-            if r.group == "chan" and any(f.reset is not None for f in r.fields.values())]
-    for r in regs:
+    span = engine_period(int(dut.CHANNELS.value)) + 8 if env.engine else 8
+    regs = []
+    for r in sorted(regmap().values(), key=lambda r: r.offset):
         with_reset = [f for f in r.fields.values() if f.reset is not None]
+        if r.group != "chan" or not with_reset:
+            continue
         exp = sum((f.reset << f.lsb) & built_mask(f, count_w, ts_w, have) for f in with_reset)
-        mask = sum(f.mask for f in with_reset)
         writable = not r.coherent and any(f.kind == "cfg" for f in r.fields.values())
-        for d in range(span):
+        regs.append((r.name, exp, sum(f.mask for f in with_reset), writable))
+    for d in range(span):
+        for name, exp, mask, writable in regs:
             if writable:
-                await bus.wr(r.name, ~exp & 0xFFFFFFFF)
+                await bus.wr(name, ~exp & 0xFFFFFFFF)
             await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
-            await env.settle(lag)
+            await env.settle(4)  # (the engine's latency: the write and the snapshot stored)
             await pulse_rst(dut, 2)
             if d:
                 await ClockCycles(dut.clk, d)
-            got = await bus.rd(r.name)
+            got = await bus.rd(name)
             assert got & mask == exp, \
-                f"{r.name} read {d} clocks after rst: {got & mask:#x}, reset value {exp:#x}"
-
+                f"{name} read {d} clocks after rst: {got & mask:#x}, reset value {exp:#x}"
 
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)

@@ -141,7 +141,7 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
               f"in {m.failed_test}: {m.eq_note}")
     if write_md:
         write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n,
-                         RESULTS / f"{table}.md", command)
+                         RESULTS / f"{table}.md", command, notes)
     status = 0
     if unreviewed:
         print(f"mutate: {len(unreviewed)} survivor(s) neither equivalent nor reviewed "
@@ -154,13 +154,16 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
 
 
 def write_results_md(head, rows, corners, mutants, reviewed, seed, run, load_txt, n,
-                     path: Path = RESULTS_MD, command: str = "make mutate") -> None:
+                     path: Path = RESULTS_MD, command: str = "make mutate",
+                     notes: list[str] | None = None) -> None:
     md = ["# Mutation coverage", "",
           f"`{command}` (scripts/mutate.py; how it works: [doc/mutation.md](../mutation.md)). "
           f"Seed {seed}, {n} mutants, {run['jobs']} jobs, {run['elapsed'] / 60:.1f} min wall time, "
           f"{run.get('cpu', 0) / 60:.1f} CPU-minutes (user + system of the tools it ran), "
-          f"{load_txt}, {run.get('date', '')}.", "",
-          "| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
+          f"{load_txt}, {run.get('date', '')}.", ""]
+    for note in notes or []:  # (each a paragraph)
+        md += [f"Note: {note.rstrip('.')}.", ""]
+    md += ["| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
     md += ["| " + " | ".join(r) + " |" for r in rows]
     md += ["", "Score = killed / (generated - equivalent). Killed counts the mutants a test failed "
            "on, those that ran into a test's simulated-time limit (timeout) and those whose "
