@@ -218,6 +218,7 @@ async def reset_values_right_after_reset(dut):
             assert got & mask == exp, \
                 f"{name} read {d} clocks after rst: {got & mask:#x}, reset value {exp:#x}"
 
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
 def test_reset(config):

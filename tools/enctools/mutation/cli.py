@@ -36,7 +36,7 @@ from ..paths import TOP
 from . import generate as gen
 from .data import load_reviewed
 from .discover import discover
-from .equivalence import equivalence
+from .equivalence import equivalence, same_as_m00
 from .modules import MODULES
 from .report import load_results, report, save_results
 from .run import run_corner
@@ -172,9 +172,7 @@ def command_of(args) -> str:
 
 def written_unchanged(m) -> bool:
     """Stage 0 on a recorded survivor: its mNN.v, as the run wrote it, is its corner's m00.v."""
-    p = m.path if m.path.is_absolute() else TOP / m.path
-    base = p.parent / "m00.v"
-    return p.exists() and base.exists() and p.read_text() == base.read_text()
+    return same_as_m00(m.path if m.path.is_absolute() else TOP / m.path)
 
 
 def report_again(args) -> int:

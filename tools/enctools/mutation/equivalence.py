@@ -37,14 +37,20 @@ def _side(c, rel: str, name: str, mutate: str) -> str:
             f"rename {c.module} {name}\n")
 
 
+def same_as_m00(path: Path) -> bool:
+    """A mutant written alone (mNN.v) has the text of its corner's unmutated design (m00.v, in the
+    same directory); False when either file is missing."""
+    base = path.parent / "m00.v"
+    return path.exists() and base.exists() and path.read_text() == base.read_text()
+
+
 def unchanged(root: Path, m: Mutant) -> bool:
     """Stage 0: the mutant written alone is the unmutated design's text (m00.v)."""
-    base = gen.corner_dir(root, m.corner) / "m00.v"
     try:
         gen.write_mutant(root, m)
     except RuntimeError:
         return False
-    return base.exists() and m.path.read_text() == base.read_text()
+    return same_as_m00(m.path)
 
 
 def equivalence(root: Path, m: Mutant, miter: bool = True) -> tuple[bool, str]:
