@@ -36,7 +36,7 @@ from ..paths import TOP
 from . import generate as gen
 from .data import load_reviewed
 from .discover import discover
-from .equivalence import equivalence, same_as_m00
+from .equivalence import STAGE0_NOTE, equivalence, same_as_m00
 from .modules import MODULES
 from .report import load_results, report, save_results
 from .run import run_corner
@@ -186,8 +186,7 @@ def report_again(args) -> int:
         found = [m for m in mutants if m.result == "survived" and written_unchanged(m)]
         for m in found:
             m.result = "equivalent"
-            m.eq_note = ("proven equivalent (written alone it is the unmutated netlist, m00.v; "
-                         "found by --report --recheck)")
+            m.eq_note = f"{STAGE0_NOTE}, found by --report --recheck"
         print(f"mutate --report --recheck: {len(found)} survivor(s) are the unmutated netlist"
               + (": " + ", ".join(f"{m.corner.label} m{m.number:02d}" for m in found) if found else ""))
         if found:

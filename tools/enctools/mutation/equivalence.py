@@ -37,6 +37,9 @@ def _side(c, rel: str, name: str, mutate: str) -> str:
             f"rename {c.module} {name}\n")
 
 
+STAGE0_NOTE = "proven equivalent (written alone it is the unmutated netlist, m00.v)"
+
+
 def same_as_m00(path: Path) -> bool:
     """A mutant written alone (mNN.v) has the text of its corner's unmutated design (m00.v, in the
     same directory); False when either file is missing."""
@@ -56,7 +59,7 @@ def unchanged(root: Path, m: Mutant) -> bool:
 def equivalence(root: Path, m: Mutant, miter: bool = True) -> tuple[bool, str]:
     """(proven equivalent, what the stages found)."""
     if unchanged(root, m):
-        return True, "proven equivalent (written alone it is the unmutated netlist, m00.v)"
+        return True, STAGE0_NOTE
     c = m.corner
     d = gen.corner_dir(root, c)
     rel = gen.rel(d)
