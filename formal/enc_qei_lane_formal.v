@@ -56,6 +56,7 @@ module enc_qei_lane_formal #(
   localparam integer MOT_W  = `ENC_QEI_ENGINE_MOT_W(CHANNELS) - MOT_CUT;
   localparam integer TIM_W  = `ENC_QEI_ENGINE_TIM_W(CHANNELS);
   localparam integer ERR_W  = `ENC_QEI_ENGINE_ERR_W(CHANNELS) - ERR_CUT;
+  `include "enc_qei_regs.vh"  // (REC_RST's reset values)
   `include "enc_qei_lane.vh"
 
   localparam integer WW = 16;  // the wrapper's wide counts
@@ -355,6 +356,24 @@ module enc_qei_lane_formal #(
       cover (rd && e_m_n != e_m && rec[R_SPEND] && rec[R_PPEND]);  // motion, a snapshot, a probe
       cover (rd && e_q_n != e_q && e_g_n != e_g);                   // errors and glitches counted
     end
+  end
+
+  // ---- the record as rst leaves it ---------------------------------------------------------------
+  (* keep *) wire [REC_W-1:0] p_rec_d;   // lane.rec_d: the record, read or not
+  // the clock after a reset (the first clock is one)
+  reg f_rst1 = 1'b1;
+  always @(posedge clk) f_rst1 <= rst;
+  // the captures' data: the snapshot's, R_SMPOS .. R_SEDGE, and the probe latch's, R_PLO ..
+  // R_PTIME: registers without a reset, which the engine reads only with R_SPEND / R_PPEND (0
+  // after rst)
+  localparam [REC_W-1:0] F_SCAP = ((REC_ONE << (R_SEDGE + 1)) - (REC_ONE << R_SMPOS)) |
+                                  ((REC_ONE << R_PEN) - (REC_ONE << R_PLO));
+
+  always @(*) begin
+    // the record as rst leaves it is REC_RST (rtl/enc_qei_lane.vh) but for the capture's data,
+    // whatever the pins and the pushes do in that clock: the engine takes REC_RST as channel
+    // 0's first record
+    if (f_past && f_rst1 && !rst) assert ((p_rec_d & ~F_SCAP) == REC_RST);
   end
 
 endmodule

@@ -810,13 +810,7 @@ module enc_qei_engine #(
 
   // ---- the visit's computation for c(v) (slot 23) ----------------------------------------------------------
   // (channel 0's first visit, after rst: its lane as rst left it, at timebase 0: the record
-  // REC_RST, 0 but for the bits the lane resets to 1, INDEX_CTRL.ARM's reset value and STATUS.DIR,
-  // and PROBE_CTRL.EN's reset value; its first write-back stores them)
-  localparam [REC_W-1:0] REC_ONE = {{(REC_W-1){1'b0}}, 1'b1};
-  localparam [REC_W-1:0] REC_RST =
-      (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
-      (ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN] ? (REC_ONE << R_PEN) : {REC_W{1'b0}}) |
-      (REC_ONE << R_DIR);
+  // REC_RST of enc_qei_lane.vh; its first write-back stores it)
   reg [REC_W-1:0] rec_q;      // c(v)'s record (its lane, in the clock of its read)
   reg [TS_W-1:0]  tv_q;       // the timebase in that clock
 

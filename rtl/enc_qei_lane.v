@@ -259,7 +259,7 @@ module enc_qei_lane #(
   always @(posedge clk) begin
     if (rst) begin
       mpos_q <= {MOT_W{1'b0}};
-      dir_q  <= 1'b1;
+      dir_q  <= REC_RST[R_DIR];  // up
     end else begin
       mpos_q <= mpos_q + {{(MOT_W-1){step_dn}}, step_up | step_dn};
       if (step_up | step_dn) begin

@@ -97,6 +97,15 @@ localparam integer R_UHIT    = R_BDIR + 1;
 localparam integer R_UARM    = R_UHIT + 1;
 localparam integer R_UD      = R_UARM + 1,        R_UD_W    = TIM_W;
 localparam integer REC_W     = R_UD + TIM_W;      // the record's width
+// The record in the clock after rst (the lane as rst leaves it: formal/enc_qei_lane.sby proves
+// it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and PROBE_CTRL.EN at their reset values. The
+// engine takes it as channel 0's record for its first visit, which comes before that lane's
+// first read. Needs enc_qei_regs.vh included before this file.
+localparam [REC_W-1:0] REC_ONE   = {{(REC_W-1){1'b0}}, 1'b1};
+localparam [REC_W-1:0] REC_RST   =
+    (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
+    (ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN] ? (REC_ONE << R_PEN) : {REC_W{1'b0}}) |
+    (REC_ONE << R_DIR);
 
 // The configuration (CFG_W bits): the channel's registers as the lane counts with them. CTRL:
 // EN, SWAP_AB, INV_A, INV_B, INV_Z, FUNC (as counted: a code no function has where FUNC_MASK
