@@ -97,10 +97,12 @@ localparam integer R_UHIT    = R_BDIR + 1;
 localparam integer R_UARM    = R_UHIT + 1;
 localparam integer R_UD      = R_UARM + 1,        R_UD_W    = TIM_W;
 localparam integer REC_W     = R_UD + TIM_W;      // the record's width
-// The record in the clock after rst (the lane as rst leaves it: formal/enc_qei_lane.sby proves
-// it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and PROBE_CTRL.EN at their reset values. The
-// engine takes it as channel 0's record for its first visit, which comes before that lane's
-// first read. Needs enc_qei_regs.vh included before this file.
+// The record in the clock after rst (the lane as rst leaves it, but for the captures' data,
+// R_SMPOS .. R_SEDGE and R_PLO .. R_PTIME, which have no reset and are read only with R_SPEND /
+// R_PPEND: formal/enc_qei_lane.sby proves it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and
+// PROBE_CTRL.EN at their reset values. The engine takes it as channel 0's record for its first
+// visit, which comes before that lane's first read. Needs enc_qei_regs.vh included before this
+// file.
 localparam [REC_W-1:0] REC_ONE   = {{(REC_W-1){1'b0}}, 1'b1};
 localparam [REC_W-1:0] REC_RST   =
     (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
