@@ -363,17 +363,13 @@ module enc_qei_lane_formal #(
   // the clock after a reset (the first clock is one)
   reg f_rst1 = 1'b1;
   always @(posedge clk) f_rst1 <= rst;
-  // the captures' data: the snapshot's, R_SMPOS .. R_SEDGE, and the probe latch's, R_PLO ..
-  // R_PTIME: registers without a reset, which the engine reads only with R_SPEND / R_PPEND (0
-  // after rst)
-  localparam [REC_W-1:0] F_SCAP = ((REC_ONE << (R_SEDGE + 1)) - (REC_ONE << R_SMPOS)) |
-                                  ((REC_ONE << R_PEN) - (REC_ONE << R_PLO));
 
   always @(*) begin
-    // the record as rst leaves it is REC_RST (rtl/enc_qei_lane.vh) but for the capture's data,
-    // whatever the pins and the pushes do in that clock: the engine takes REC_RST as channel
-    // 0's first record
-    if (f_past && f_rst1 && !rst) assert ((p_rec_d & ~F_SCAP) == REC_RST);
+    // the record as rst leaves it is REC_RST (rtl/enc_qei_lane.vh) but for the captures' data
+    // (REC_CAP: no reset, read only with R_SPEND / R_PPEND, which REC_RST holds at 0), whatever
+    // the pins and the pushes do in that clock: the engine takes REC_RST as channel 0's first
+    // record
+    if (f_past && f_rst1 && !rst) assert ((p_rec_d & ~REC_CAP) == REC_RST);
   end
 
 endmodule

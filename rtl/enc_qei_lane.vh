@@ -97,13 +97,15 @@ localparam integer R_UHIT    = R_BDIR + 1;
 localparam integer R_UARM    = R_UHIT + 1;
 localparam integer R_UD      = R_UARM + 1,        R_UD_W    = TIM_W;
 localparam integer REC_W     = R_UD + TIM_W;      // the record's width
-// The record in the clock after rst (the lane as rst leaves it, but for the captures' data,
-// R_SMPOS .. R_SEDGE and R_PLO .. R_PTIME, which have no reset and are read only with R_SPEND /
-// R_PPEND: formal/enc_qei_lane.sby proves it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and
+// The record in the clock after rst (the lane as rst leaves it, but for the bits of REC_CAP:
+// formal/enc_qei_lane.sby proves it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and
 // PROBE_CTRL.EN at their reset values. The engine takes it as channel 0's record for its first
 // visit, which comes before that lane's first read. Needs enc_qei_regs.vh included before this
-// file.
+// file. REC_CAP: the captures' data, the snapshot's R_SMPOS .. R_SEDGE and the probe latch's
+// R_PLO .. R_PTIME, registers without a reset, read only with R_SPEND / R_PPEND.
 localparam [REC_W-1:0] REC_ONE   = {{(REC_W-1){1'b0}}, 1'b1};
+localparam [REC_W-1:0] REC_CAP   = ((REC_ONE << (R_SEDGE + 1)) - (REC_ONE << R_SMPOS)) |
+                                   ((REC_ONE << R_PEN) - (REC_ONE << R_PLO));
 localparam [REC_W-1:0] REC_RST   =
     (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
     (ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN] ? (REC_ONE << R_PEN) : {REC_W{1'b0}}) |
