@@ -130,14 +130,15 @@ class Mutant:
 
     def mutant_id(self) -> str:
         """A stable id for the reviewed-survivors file: module, corner, mode, cell type, port/bit,
-        wire/bit and the source text the mutation points at (not line numbers or Yosys's cell
-        counters, which move when unrelated lines are added)."""
+        wire/bit and the source text the mutation points at (not line numbers, Yosys's cell
+        counters or the run's work directory, which move when unrelated lines are added or the
+        run is elsewhere: see wire_key)."""
         o = self.opts
         cell_type = o.get("cell", "").lstrip("$").split("$")[0]
         texts = [src_text(s) for s in o.get("src", [])]
         sig = "|".join([self.corner.module, self.corner.tag, o.get("mode", ""), cell_type,
                         o.get("port", ""), o.get("portbit", ""), o.get("ctrlbit", ""),
-                        o.get("wire", ""), o.get("wirebit", ""), *texts])
+                        wire_key(o.get("wire", "")), o.get("wirebit", ""), *texts])
         return hashlib.sha1(sig.encode()).hexdigest()[:10]
 
     def describe(self) -> str:
@@ -147,7 +148,7 @@ class Mutant:
         if "ctrlbit" in o:
             what += f" ctrl[{o['ctrlbit']}]"
         if "wire" in o:
-            what += f" ({o['wire']}[{o.get('wirebit')}])"
+            what += f" ({unsnap(o['wire'])}[{o.get('wirebit')}])"
         srcs = sorted(o.get("src", []), key=lambda x: len(src_text(x)))  # innermost first
         if srcs:
             loc = unsnap(srcs[0].split("-")[0].rsplit(".", 1)[0])
@@ -158,6 +159,23 @@ class Mutant:
 def unsnap(text: str) -> str:
     """A path into any run's RTL copy (build/mutate/<work>/src/rtl/x.v) as rtl/x.v."""
     return re.sub(r"build/mutate/[^/\s]+/src/", "", text)
+
+
+# the call site in a function result's wire name: tstamp$func$<file>:<line>$<counter>.$result
+_CALL_SITE = re.compile(r"([^$\s]+?\.s?vh?):(\d+)\$\d+")
+
+
+def wire_key(wire: str) -> str:
+    """A wire's name as the id hashes it. A function result's wire names its call site by file,
+    line and Yosys's counter (tstamp$func$build/mutate/<work>/src/rtl/x.v:927$2232.$result); the
+    key names it by the file as in the repository and the text of that line instead, so that the
+    id does not change with the work directory, nor when unrelated lines are added."""
+    def site(m: re.Match) -> str:
+        f, line = m.group(1), int(m.group(2))
+        whole = f"{f}:{line}.1-{line}.100000"
+        text = src_text(whole)
+        return f"{unsnap(f)}:" + (f"`{text}`" if text != whole else str(line))  # (file gone)
+    return _CALL_SITE.sub(site, wire)
 
 
 def parse_mutate(command: str) -> dict:

@@ -128,6 +128,11 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
     n = sum(1 for _ in mutants)
     print(f"\nseed {seed}, {n} mutants, {run['jobs']} jobs, {run['elapsed'] / 60:.1f} min wall, "
           f"{run.get('cpu', 0) / 60:.1f} CPU-min; {load_txt}")
+    by_id: dict[str, set] = {}
+    for m in mutants:
+        by_id.setdefault(m.mutant_id(), set()).add(m.command.split(" -src ")[0])
+    notes = list(notes) + [f"mutants with different mutations share the id {i}: a reviewed reason "
+                           "would cover both" for i, cmds in by_id.items() if len(cmds) > 1]
     for note in notes:
         print(f"note: {note}")
     surv = [m for m in mutants if m.result == "survived"]
