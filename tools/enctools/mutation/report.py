@@ -10,7 +10,8 @@ from pathlib import Path
 
 from ..paths import RESULTS, TOP
 from . import generate as gen
-from .data import KILLS, REVIEWED, Corner, Group, Module, Mutant, load_reviewed, tag_of
+from .data import (KILLS, REVIEWED, Corner, Group, Module, Mutant, load_reviewed, tag_of,
+                   unsnap)
 from .modules import MODULES
 
 RESULTS_MD = RESULTS / "mutation.md"
@@ -109,6 +110,15 @@ def table_rows(modules, corners, mutants, reviewed) -> tuple[tuple, list[tuple]]
     return head, rows
 
 
+def shared_ids(mutants) -> list[str]:
+    """The ids that two different mutations have (see Mutant.mutant_id: two calls of one function
+    on one line can give them), in the order met."""
+    by_id: dict[str, set] = {}
+    for m in mutants:
+        by_id.setdefault(m.mutant_id(), set()).add(unsnap(m.command.split(" -src ")[0]))
+    return [i for i, cmds in by_id.items() if len(cmds) > 1]
+
+
 def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
            write_md: bool = True, table: str = "mutation", command: str = "make mutate") -> int:
     reviewed = load_reviewed()
@@ -128,11 +138,8 @@ def report(modules, corners, mutants, seed: int, run: dict, notes: list[str],
     n = sum(1 for _ in mutants)
     print(f"\nseed {seed}, {n} mutants, {run['jobs']} jobs, {run['elapsed'] / 60:.1f} min wall, "
           f"{run.get('cpu', 0) / 60:.1f} CPU-min; {load_txt}")
-    by_id: dict[str, set] = {}
-    for m in mutants:
-        by_id.setdefault(m.mutant_id(), set()).add(m.command.split(" -src ")[0])
     notes = list(notes) + [f"mutants with different mutations share the id {i}: a reviewed reason "
-                           "would cover both" for i, cmds in by_id.items() if len(cmds) > 1]
+                           "would cover both" for i in shared_ids(mutants)]
     for note in notes:
         print(f"note: {note}")
     surv = [m for m in mutants if m.result == "survived"]
