@@ -115,6 +115,12 @@ BLOCKS = [
           seeds=3, quick=None),
     Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 2, "CHANNELS": 16, "ENGINE": 1}, device="ecp5",
           seeds=3, quick=None),
+    # the most lean channels the HX8K placed, per architecture (one more did not: 5 per channel
+    # fill its 7,680 logic cells, 7 on the engine take 96 %, and nextpnr found no legal
+    # placement for either). --quick leaves them out
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 4}, seeds=3, quick=None),
+    Block("enc_qei_wb", {"COUNT_W": 32, "PROFILE": 3, "CHANNELS": 6, "ENGINE": 1}, seeds=3,
+          quick=None),
     # ... with an edge FIFO of 16 entries per channel beside the engine (enc_qei_efifo_bank): its
     # cost is the difference to the 16 lean engine rows. Each FIFO has its own memory: on the
     # iCE40 3 SB_RAM40_4K a channel (the HX8K has 32), on the ECP5 distributed RAM
