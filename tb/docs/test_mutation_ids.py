@@ -2,10 +2,11 @@
 """The ids of scripts/mutate_reviewed.txt (enctools.mutation.data.Mutant.mutant_id).
 
 Plain pytest, no Yosys. A mutant on a function's result wire
-(`tstamp$func$<file>:<line>$<n>.$result`) keeps its id in another work directory (build/mutate/<work>/src/...), with another Yosys counter
-and with its call site moved to another line; two call sites with different text get different
-ids; a run directory that is gone leaves the file and line, without the work directory; two calls
-of one function on one line share an id, and the report's shared_ids names it.
+(`tstamp$func$<file>:<line>$<n>.$result`) keeps its id in another work directory
+(build/mutate/<work>/src/...), with another Yosys counter and with its call site moved to another
+line; two call sites with different text get different ids; a run directory that is gone leaves
+the file and line, without the work directory; two calls of one function on one line share an
+id, and the report's shared_ids names it.
 """
 
 from __future__ import annotations

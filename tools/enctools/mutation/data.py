@@ -172,9 +172,10 @@ def wire_key(wire: str) -> str:
     id does not change with the work directory, nor when unrelated lines are added."""
     def site(m: re.Match) -> str:
         f, line = m.group(1), int(m.group(2))
-        whole = f"{f}:{line}.1-{line}.100000"
-        text = src_text(whole)
-        return f"{unsnap(f)}:" + (f"`{text}`" if text != whole else str(line))  # (file gone)
+        lines = source_lines(f)
+        if len(lines) < line:  # (the run's copy is gone)
+            return f"{unsnap(f)}:{line}"
+        return f"{unsnap(f)}:`{' '.join(lines[line - 1].split())}`"
     return _CALL_SITE.sub(site, wire)
 
 
@@ -196,18 +197,23 @@ def parse_mutate(command: str) -> dict:
 _SRC_CACHE: dict[str, list[str]] = {}
 
 
+def source_lines(f: str) -> list[str]:
+    """The lines of a source file named relative to TOP (read once; none when it is gone)."""
+    if f not in _SRC_CACHE:
+        try:
+            _SRC_CACHE[f] = (TOP / f).read_text().splitlines()
+        except OSError:
+            _SRC_CACHE[f] = []
+    return _SRC_CACHE[f]
+
+
 def src_text(src: str) -> str:
     """The source text of a Yosys src attribute "file:l1.c1-l2.c2", whitespace collapsed."""
     m = re.fullmatch(r"(.+):(\d+)\.(\d+)-(\d+)\.(\d+)", src)
     if not m:
         return src
     f, l1, c1, l2, c2 = m.group(1), *map(int, m.groups()[1:])
-    if f not in _SRC_CACHE:
-        try:
-            _SRC_CACHE[f] = (TOP / f).read_text().splitlines()
-        except OSError:
-            _SRC_CACHE[f] = []
-    lines = _SRC_CACHE[f][l1 - 1:l2]
+    lines = source_lines(f)[l1 - 1:l2]
     if not lines:
         return src
     if len(lines) == 1:
