@@ -353,6 +353,17 @@ module enc_qei_engine_formal #(
   reg  [3:0]          f_rdw_ch;   // ... of this channel
   reg                 f_rdw_sv;   // ... right after a COUNT_LO read that stored its channel's latch
   wire [7:0]          f_rem;      // clocks from now to the bus's answer, by its state, at most
+  // a write requested while a write of its channel is not stored yet (COUNT_W <= 32; the bounds:
+  // below)
+  reg                 f_wdw;      // such a write is in flight
+  reg  [3:0]          f_wdw_ch;   // ... of this channel
+  reg                 f_wdw_pt;   // ... a COUNT_LO write with some but not all byte lanes
+  reg  [7:0]          f_wdw_age;  // clocks since the answer of the channel's write it waits for
+  reg                 f_wdw_st;   // ... that write is a state write
+  reg                 f_wdw_nw;   // ... it did not wait
+  reg  [2:0]          f_wdw_rq;   // ... its answer's delay after its request
+  wire [7:0]          f_wrem;     // clocks from now to the write's answer, by the bus's state
+  (* keep *) wire [3:0] p_b_wstrb;  // eng.b_wstrb_q: the bus request's byte enables
   reg                 f_lwt;      // COUNT_W > 32: the read waited for the write of the channel
   reg  [3:0]          f_lwt_ch;   // ... whose latch it stores
   reg  [7:0]          f_lwt_age;  // ... that write's clocks since its answer
@@ -476,6 +487,28 @@ module enc_qei_engine_formal #(
       end
     end
   end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      f_wdw <= 1'b0;
+    end else if (req_valid) begin
+      f_wdw     <= COUNT_W <= 32 && req_write && (f_owed[req_ch] != 2'd0);
+      f_wdw_ch  <= req_ch;
+      f_wdw_pt  <= req_word == OFF_CNT_LO && (|req_wstrb) && !(&req_wstrb);
+      f_wdw_age <= (f_wage[req_ch] == 8'hFF) ? 8'hFF : f_wage[req_ch] + 8'd1;
+      f_wdw_st  <= p_pend_st[req_ch];
+      f_wdw_nw  <= f_nowait[req_ch];
+      f_wdw_rq  <= f_wrq[req_ch];
+    end else begin
+      if (resp_valid) f_wdw <= 1'b0;
+      f_wdw_age <= (f_wdw_age == 8'hFF) ? f_wdw_age : f_wdw_age + 8'd1;
+    end
+  end
+  // (a write goes B_WAIT, B_POST, B_DONE; one that reads the count first B_WAIT, B_RD1, B_RD2,
+  // B_POST, B_DONE)
+  assign f_wrem = (p_b_st == B_WAIT) ? (f_wdw_pt ? 8'd6 : 8'd4) : (p_b_st == B_RD1) ? 8'd5 :
+                  (p_b_st == B_RD2) ? 8'd4 : (p_b_st == B_POST) ? 8'd3 :
+                  (p_b_st == B_DONE) ? 8'd2 : 8'd1;
 
   always @(posedge clk) begin
     if (rst) begin
@@ -616,6 +649,32 @@ module enc_qei_engine_formal #(
                   (p_pend_st[f_rdw_ch] ? P + 30 : (f_wrq[f_rdw_ch] == 3'd6) ? P + 68 : P + 66) ||
                   (f_lwt && f_lwt_age <= P + 63));
       end
+      // a write that waited for a write of its channel: as a read, one clock sooner (B_WAIT,
+      // B_POST, B_DONE), or one later when it reads the count first; by the RDL, P + 61 clocks
+      // after the earlier write's answer (a state write: P + 25), and when that write did not
+      // wait itself P + 65 after its request (a state write: P + 29; after a COUNT_LO write with
+      // some byte lanes off: P + 67); each 2 more for a COUNT_LO write with some byte lanes off
+      if (f_wdw) begin
+        assert (f_wdw_ch < CHANNELS && (p_b_st == B_IDLE ? resp_valid :
+                                        (p_b_ch == f_wdw_ch && p_b_wr)));
+        if (p_b_st == B_WAIT || p_b_st == B_RD1 || p_b_st == B_RD2)
+          assert (f_wdw_age == f_wage[f_wdw_ch] && f_wdw_st == p_pend_st[f_wdw_ch] &&
+                  f_wdw_nw == f_nowait[f_wdw_ch] && f_wdw_rq == f_wrq[f_wdw_ch]);
+        if (p_b_st == B_RD1 || p_b_st == B_RD2 || p_b_st == B_POST)
+          assert (!(|((p_pend | p_busy) & (1 << f_wdw_ch))));
+        assert (f_wdw_pt == (p_b_word == OFF_CNT_LO && (|p_b_wstrb) && !(&p_b_wstrb)));
+        if (p_b_st == B_RD1 || p_b_st == B_RD2) assert (f_wdw_pt);
+        assert (f_wdw_age <= P + 58 + {5'd0, f_rq_age});
+        if (!(p_b_st == B_WAIT && (|((p_pend | p_busy) & (1 << f_wdw_ch)))))
+          assert (f_wdw_age + f_wrem <= (f_wdw_st ? P + 26 : P + 62) + (f_wdw_pt ? 8'd2 : 8'd0));
+      end
+      if (f_wdw && resp_valid) begin
+        assert (f_wdw_age <= (f_wdw_st ? P + 25 : P + 61) + (f_wdw_pt ? 8'd2 : 8'd0));
+        if (f_wdw_nw)
+          assert ({5'd0, f_wdw_rq} + f_wdw_age <=
+                  (f_wdw_st ? P + 29 : (f_wdw_rq == 3'd6) ? P + 67 : P + 65) +
+                  (f_wdw_pt ? 8'd2 : 8'd0));
+      end
     end
   end
 
@@ -720,7 +779,6 @@ module enc_qei_engine_formal #(
   (* keep *) wire [41:0]         p_e_pend;   // eng.e_pend: c(v)'s state write
   (* keep *) wire [41:0]         p_pend_wd;  // eng.pend_wdata: the write into a write slot
   (* keep *) wire [31:0]         p_b_wdata;  // eng.b_wdata_q: the bus request's data
-  (* keep *) wire [3:0]          p_b_wstrb;  // eng.b_wstrb_q: ... its byte enables
   (* keep *) wire [31:0]         p_b_cnt;    // eng.b_cnt_q: COUNT_LO as read for a write
   (* keep *) wire [63:0]         p_o_mot;    // eng.o_mot
   (* keep *) wire [63:0]         p_o_edge;   // eng.o_edge

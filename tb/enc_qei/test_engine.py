@@ -13,7 +13,9 @@ the same, shown at once):
   COUNT_LO write), or P + 26 (EVENTS, QERR_COUNT: on what a read could show at the request, an
   event after it stays), in order with the reads and writes after it; a read right after a write
   sees it and is answered at most P + 66 clocks after the write's request (P + 30 after a state
-  write, P + 68 after a COUNT_LO write with some byte lanes off), and at some phase that late;
+  write, P + 68 after a COUNT_LO write with some byte lanes off), and at some phase that late; a
+  write right after a write of its channel one clock sooner (a COUNT_LO write with some byte
+  lanes off: one clock later than the read), a write of another channel at once;
 - COUNT_W > 32: a COUNT_LO read of another channel stores the COUNT_HI latch of the channel read
   before, and the next access of that channel waits for the store (P + 23 after that read's
   answer, P + 29 after its request); that read waits for the other channel's unstored write
@@ -25,7 +27,9 @@ the same, shown at once):
   the one before (GSNAP_TIME tells when it was taken), a channel's own one waits for its visit
   (SNAP_TIME tells), and SNAP_READY rises only when SNAP_* hold the snapshot; a request that waits
   when its source is stopped (GSNAP_CTRL.PERIOD_EN written 0) is still taken, at most P clocks
-  after the write's snapshot clock, and GSNAP_TIME holds still from P + 44 clocks after it.
+  after the write's snapshot clock, and GSNAP_TIME holds still from P + 44 clocks after it; a
+  channel's SNAP_CTRL.CMD then GSNAP_CTRL.CMD: in that order with a read of the channel between
+  them, the global one possibly first without it.
 
 Runs on ENGINE_CONFIGS (enc_qei_wb, lean, COUNT_W 32 or 64, TS_W 32; 16 channels on Verilator
 whatever SIM says). Every cocotb test logs its seed.
@@ -45,6 +49,7 @@ from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART
                               ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SAVE_READ,
                               ENGINE_SAVE_WAIT, ENGINE_SAVE_WAIT_REQ, ENGINE_SHOW,
                               ENGINE_SHOW_COUNT, ENGINE_STATE_WAIT, ENGINE_WAIT,
+                              ENGINE_WRITE_PART_WAIT, ENGINE_WRITE_STATE_WAIT, ENGINE_WRITE_WAIT,
                               PER_CHANNEL_ANSWER, PROFILES, begin, build_name, channel_envs,
                               engine_period, read_snapshot)
 from enctools.qei.model import QUAD, QeiModel
@@ -502,6 +507,118 @@ async def read_after_write_wait(dut):
             assert worst[reg] >= bound - 2, \
                 f"the worst read of {reg} after a write was answered at P + {worst[reg]}: the " \
                 f"RDL's P + {bound} is loose"
+
+
+@cocotb_test()
+async def write_after_write_wait(dut):
+    """A write of a channel, then at once a second write of the same channel, at every phase of the
+    engine's visits: the second is answered at most
+    P + ENGINE_WRITE_WAIT clocks after the first's request (after IRQ_EN, a state write:
+    P + ENGINE_WRITE_STATE_WAIT; after a COUNT_LO write with byte lanes 0 and 1:
+    P + ENGINE_WRITE_PART_WAIT; the second itself a COUNT_LO write with byte lanes 0 and 1: one
+    clock more; the RDL), and within 2 clocks of that at some phase (the bound is the real one);
+    reads after them see both writes, the second last. A write of another channel right after a
+    write does not wait: answered in ENGINE_ANSWER clocks. The channels stand still. Per-channel
+    build: the second write answered PER_CHANNEL_ANSWER after its own request."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    p = engine_period(n) if env.engine else 2
+    # (first register, its byte enables, second register, its byte enables, bound)
+    cases = (("PRESET_LO", 0xF, "PRESET_LO", 0xF, ENGINE_WRITE_WAIT),
+             ("COUNT_LO", 0x3, "PRESET_LO", 0xF, ENGINE_WRITE_PART_WAIT),
+             ("IRQ_EN", 0xF, "IRQ_EN", 0xF, ENGINE_WRITE_STATE_WAIT),
+             ("PRESET_LO", 0xF, "COUNT_LO", 0x3, ENGINE_WRITE_WAIT + 2))
+    masks = {"PRESET_LO": 0xFFFFFFFF, "COUNT_LO": 0xFFFF, "IRQ_EN": 0x3FF}
+
+    async def value_for(reg, sel, k):
+        old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
+        return (old & ~masks[reg]) | (rng.getrandbits(32) & masks[reg])
+
+    for first, sel1, second, sel2, bound in cases:
+        worst = 0
+        for rel in range(p):
+            k = rng.randrange(n)
+            v1 = await value_for(first, sel1, k)
+            v2 = await value_for(second, sel2, k)
+            if first == second:
+                v2 ^= 1  # (the read must tell the second from the first)
+            await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
+            w, _, _ = await raw.access(addr(first, k), v1, sel=sel1)
+            s, _, _ = await raw.access(addr(second, k), v2, sel=sel2)
+            done = int(raw.tb.value)
+            if env.engine:
+                assert done - w <= p + bound, \
+                    f"channel {k}: a {second} write right after a {first} write answered " \
+                    f"{done - w} clocks after the first's request (bound P + {bound}, P {p})"
+            else:
+                assert done - s == PER_CHANNEL_ANSWER, f"{second}: answered {done - s} clocks"
+            worst = max(worst, done - w - p)
+            got1 = (await raw.access(addr(first, k)))[1]
+            got2 = (await raw.access(addr(second, k)))[1]
+            assert got2 == v2, f"channel {k}: {second} written {v2:#x} second, reads {got2:#x}"
+            if first != second:
+                assert got1 == v1, f"channel {k}: {first} written {v1:#x} first, reads {got1:#x}"
+            await ClockCycles(dut.clk, p + ENGINE_WAIT)
+        if env.engine:
+            dut._log.info("a %s write right after a %s write of its channel answered at worst "
+                          "P + %d clocks after the first's request (bound P + %d, P %d)", second,
+                          first, worst, bound, p)
+            assert worst >= bound - 2, \
+                f"the worst {second} write after a {first} write was answered at P + {worst}: " \
+                f"the RDL's P + {bound} is loose"
+    if n > 1:
+        for _ in range(8):
+            k, j = rng.sample(range(n), 2)
+            await at_phase(dut, p, rng.randrange(p))
+            await raw.access(addr("PRESET_LO", k), rng.getrandbits(32))
+            got = await answered(raw, addr("PRESET_LO", j), rng.getrandbits(32))
+            want = ENGINE_ANSWER if env.engine else PER_CHANNEL_ANSWER
+            assert got == want, f"a write of channel {j} right after one of channel {k} answered " \
+                                f"in {got} clocks, not {want}: it waited"
+            await ClockCycles(dut.clk, p + ENGINE_WAIT)
+
+
+@cocotb_test()
+async def snapshot_order(dut):
+    """A channel's SNAP_CTRL.CMD, then at once GSNAP_CTRL.CMD, at phases spread over the engine's
+    visits, the channels standing still. With a read of the channel between the two writes (the
+    RDL's way to keep the order) every channel's SNAP_TIME is GSNAP_TIME afterwards, on both
+    builds. Without it the per-channel build takes them in the order written (the same); the
+    engine may take the global one first (the RDL, CAPS.ENGINE shared (3)): then that channel's
+    SNAP_TIME is later than GSNAP_TIME, by at most 2 P + ENGINE_ACT clocks after its write's
+    request, at some phase (the warning is real), and every other channel's is GSNAP_TIME."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    p = engine_period(n) if env.engine else 2
+    wait = engine_period(n) + ENGINE_SHOW + 20
+    late = 0
+    trials = 8
+    for i in range(2 * trials):
+        keep = i % 2 == 1
+        k = rng.randrange(n)
+        await at_phase(dut, p, (i // 2 * p // trials + rng.randrange(max(1, p // trials))) % p)
+        w, _, _ = await raw.access(addr("SNAP_CTRL", k), pack("SNAP_CTRL", CMD=1))
+        if keep:
+            await raw.access(addr("STATUS", k))
+        await raw.access(addr("GSNAP_CTRL"), pack("GSNAP_CTRL", CMD=1))
+        await ClockCycles(dut.clk, 2 * wait)
+        g = (await raw.access(addr("GSNAP_TIME")))[1]
+        times = [(await raw.access(addr("SNAP_TIME", j)))[1] for j in range(n)]
+        what = f"trial {i}: SNAP_CTRL.CMD of channel {k} (request {w:#x}), " + \
+               ("a read of it, " if keep else "") + f"then GSNAP_CTRL.CMD: GSNAP_TIME {g:#x}"
+        for j in range(n):
+            if j != k or keep or not env.engine:
+                assert times[j] == g, f"{what}, channel {j}'s SNAP_TIME {times[j]:#x}"
+            else:
+                assert g <= times[j] <= w + 2 * p + ENGINE_ACT, \
+                    f"{what}, channel {j}'s own snapshot at {times[j]:#x}"
+                late += times[j] > g
+    dut._log.info("the global snapshot taken before the channel's own one in %d of %d trials "
+                  "without a read between", late, trials)
+    if env.engine:
+        assert late > 0, "the global snapshot was never taken first: the RDL's warning is not real"
 
 
 @cocotb_test()
@@ -998,6 +1115,9 @@ def test_rdl_says_the_bounds():
         "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
         "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
         "ENGINE_PART_WAIT": r"and P \+ (\d+) after a COUNT_LO write with some but not all byte enables set",
+        "ENGINE_WRITE_WAIT": r"answered one clock sooner than such a read would be \(P \+ (\d+), P \+ \d+, P \+ \d+ after",
+        "ENGINE_WRITE_STATE_WAIT": r"one clock sooner than such a read would be \(P \+ \d+, P \+ (\d+), P \+ \d+ after",
+        "ENGINE_WRITE_PART_WAIT": r"one clock sooner than such a read would be \(P \+ \d+, P \+ \d+, P \+ (\d+) after",
         "ENGINE_SAVE_WAIT": r"answered at most P \+ (\d+) clocks after the COUNT_LO read's answer",
         "ENGINE_SAVE_WAIT_REQ": r"\(P \+ (\d+) after its request when it did not wait\)",
         "ENGINE_SAVE_READ": r"then it is answered at most P \+ (\d+) clocks after that write's answer",
