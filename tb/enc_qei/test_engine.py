@@ -415,15 +415,17 @@ async def write_effect(dut):
     """Every channel moving forward a step a clock; at phases spread over the engine's reads, a
     COUNT_LO write to a random channel: a read right after it gives the written count (plus the
     steps since); it loads the count once, in one clock E (from a global snapshot later: SNAP_COUNT =
-    value + the steps after E), no earlier than on the per-channel build and at most
-    P + ENGINE_ACT later. Then, a channel standing still, COUNT_LO writes with some byte lanes: the
+    value + the steps after E), no earlier than on the per-channel build (REF_LOAD after the
+    request) and at most P + ENGINE_ACT clocks after the request (the RDL: the write acts, loading
+    the count in the clock before the channel's read, at most P + 18 clocks after its request).
+    Then, a channel standing still, COUNT_LO writes with some byte lanes: the
     other lanes from COUNT."""
     env, rng, envs, models = await start_all(dut, index=False)
     n = len(envs)
     raw = WbRaw(dut)
     p = engine_period(n) if env.engine else 2
     visit = p // max(n, 2)
-    wlag = p + ENGINE_ACT if env.engine else 0
+    wlag = p + ENGINE_ACT - REF_LOAD if env.engine else 0  # (E - REF_LOAD after the request)
     walker = ClockWalk(dut, models, rng, positions=[e.pos for e in envs], shortest=1, longest=1,
                        p_reverse=0)
     task = cocotb.start_soon(walker.run(10 ** 9))
@@ -447,7 +449,8 @@ async def write_effect(dut):
         d = load - w - REF_LOAD
         assert 0 <= d <= wlag, \
             f"channel {k}: the COUNT_LO write (stamp {w:#x}) loaded the count in clock {load:#x}, " \
-            f"{d} clocks later than the per-channel build (at most {wlag})"
+            f"{d} clocks later than the per-channel build (at most {wlag}: P + {ENGINE_ACT} after " \
+            f"the request)"
         worst = max(worst, d)
     task.cancel()
     if env.engine:
