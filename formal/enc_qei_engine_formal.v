@@ -558,6 +558,12 @@ module enc_qei_engine_formal #(
         if (p_b_st == B_DONE && p_b_wr) assert (f_rq_age == 3'd2 || (f_rq_age == 3'd4 && p_b_word == OFF_CNT_LO));
       end
       for (k = 0; k < CHANNELS; k = k + 1) begin
+        // a write is stored (neither waiting nor being applied) by P + 57 clocks after its answer
+        // at the latest (a state write: P + 21), so an access of the channel requested P + 57
+        // clocks or more after that answer (P + 21), whose B_WAIT is a clock later, does not
+        // wait for it (the RDL)
+        if ((p_pend[k] || p_busy[k]) && !f_wsave[k])
+          assert (f_wage[k] <= (p_pend_st[k] ? P + 21 : P + 57));
         if (f_wlive[k]) begin
           // the RDL's bounds
           assert (f_wage[k] <= (p_pend_st[k] ? P + 22 : P + 14));

@@ -15,7 +15,8 @@ the same, shown at once):
   sees it and is answered at most P + 66 clocks after the write's request (P + 30 after a state
   write, P + 68 after a COUNT_LO write with some byte lanes off), and at some phase that late; a
   write right after a write of its channel one clock sooner (a COUNT_LO write with some byte
-  lanes off: one clock later than the read), a write of another channel at once;
+  lanes off: one clock later than the read), a write of another channel at once; an access
+  P + 57 clocks after a write's answer (P + 21 after a state write) without a wait;
 - COUNT_W > 32: a COUNT_LO read of another channel stores the COUNT_HI latch of the channel read
   before, and the next access of that channel waits for the store (P + 23 after that read's
   answer, P + 29 after its request); that read waits for the other channel's unstored write
@@ -46,7 +47,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from enctools.qei.bus import WbRaw, signed
 from enctools.qei.env import (ENGINE_ACT, ENGINE_ANSWER, ENGINE_IRQ, ENGINE_PART_ANSWER,
-                              ENGINE_PART_WAIT, ENGINE_READ_ANSWER, ENGINE_SAVE_READ,
+                              ENGINE_NO_WAIT, ENGINE_PART_WAIT, ENGINE_READ_ANSWER,
+                              ENGINE_SAVE_READ, ENGINE_STATE_NO_WAIT,
                               ENGINE_SAVE_WAIT, ENGINE_SAVE_WAIT_REQ, ENGINE_SHOW,
                               ENGINE_SHOW_COUNT, ENGINE_STATE_WAIT, ENGINE_WAIT,
                               ENGINE_WRITE_PART_WAIT, ENGINE_WRITE_STATE_WAIT, ENGINE_WRITE_WAIT,
@@ -580,6 +582,53 @@ async def write_after_write_wait(dut):
             assert got == want, f"a write of channel {j} right after one of channel {k} answered " \
                                 f"in {got} clocks, not {want}: it waited"
             await ClockCycles(dut.clk, p + ENGINE_WAIT)
+
+
+@cocotb_test()
+async def no_wait_after_store(dut):
+    """A write of a channel, then a read of it (STATUS) requested P + ENGINE_NO_WAIT clocks after
+    the write's answer (PRESET_LO; a COUNT_LO write with byte lanes 0 and 1; IRQ_EN, a state write:
+    P + ENGINE_STATE_NO_WAIT), at every phase of the engine's visits: the read is answered in its
+    own ENGINE_READ_ANSWER clocks, it does not wait (the RDL). On 1 and 3 channels also one clock
+    earlier, where the read waits at some phase (the bound is the real one); on 16 channels
+    PRESET_LO and IRQ_EN. Per-channel build: a read 3 clocks after a write's answer takes its
+    PER_CHANNEL_ANSWER."""
+    env, rng, envs, models = await start_all(dut, index=False)
+    n = len(envs)
+    raw = WbRaw(dut)
+    p = engine_period(n) if env.engine else 2
+    want = ENGINE_READ_ANSWER if env.engine else PER_CHANNEL_ANSWER
+    tight = env.engine and p <= 72
+    cases = (("PRESET_LO", 0xF, 0xFFFFFFFF, ENGINE_NO_WAIT), ("COUNT_LO", 0x3, 0xFFFF, ENGINE_NO_WAIT),
+             ("IRQ_EN", 0xF, 0x3FF, ENGINE_STATE_NO_WAIT))
+    for reg, sel, mask, bound in (cases if p <= 72 else cases[::2]):
+        waited = 0
+        for rel in range(p):
+            for early in ((0, 1) if tight else (0,)):
+                k = rng.randrange(n)
+                old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
+                await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
+                await raw.access(addr(reg, k), (old & ~mask) | (rng.getrandbits(32) & mask), sel=sel)
+                answer = int(raw.tb.value)
+                at = answer + (p + bound - early if env.engine else 3)
+                while int(raw.tb.value) < at - 1:
+                    await FallingEdge(dut.clk)
+                r, _, _ = await raw.access(addr("STATUS", k))
+                assert r == at, f"the read requested in clock {r:#x}, not {at:#x}"
+                got = int(raw.tb.value) - r
+                if early:
+                    waited += got != want
+                else:
+                    assert got == want, \
+                        f"channel {k}: a read requested P + {bound} clocks after the answer to a " \
+                        f"{reg} write was answered {got} clocks after its request, not {want}: it " \
+                        f"waited for the write"
+                await ClockCycles(dut.clk, p + ENGINE_WAIT)
+        if tight:
+            dut._log.info("a read P + %d clocks after a %s write's answer waited at %d of %d "
+                          "phases (P %d)", bound - 1, reg, waited, p, p)
+            assert waited > 0, f"no read P + {bound - 1} clocks after a {reg} write's answer " \
+                               f"waited: the RDL's P + {bound} is loose"
 
 
 @cocotb_test()
@@ -1118,6 +1167,8 @@ def test_rdl_says_the_bounds():
         "ENGINE_WAIT": r"a read requested right after a write of its channel is answered at most P \+ (\d+) clocks",
         "ENGINE_STATE_WAIT": r"\(a state write: P \+ (\d+)\)",
         "ENGINE_PART_WAIT": r"and P \+ (\d+) after a COUNT_LO write with some but not all byte enables set",
+        "ENGINE_NO_WAIT": r"one requested P \+ (\d+) clocks or more after the write's answer",
+        "ENGINE_STATE_NO_WAIT": r"after the write's answer \(after a state write: P \+ (\d+)\) does not wait",
         "ENGINE_WRITE_WAIT": r"answered one clock sooner than such a read would be \(P \+ (\d+), P \+ \d+, P \+ \d+ after",
         "ENGINE_WRITE_STATE_WAIT": r"one clock sooner than such a read would be \(P \+ \d+, P \+ (\d+), P \+ \d+ after",
         "ENGINE_WRITE_PART_WAIT": r"one clock sooner than such a read would be \(P \+ \d+, P \+ \d+, P \+ (\d+) after",
