@@ -472,6 +472,28 @@ async def write_effect(dut):
             f"channel {k}: COUNT_LO {old:#x}, written {new:#x} with byte enables {strb:#x}: {got:#x}"
 
 
+async def after_write(dut, raw: WbRaw, env, p: int, phase: int, k: int, first: tuple,
+                      second: tuple, bound: int) -> tuple[int, int]:
+    """At the phase of channel k's visits: a write of first = (register, value, byte enables),
+    then at once an access of second (the same, a read when its value is None). Its answer is
+    held to P + bound clocks after the first's request on the engine, to PER_CHANNEL_ANSWER after
+    its own on the per-channel build; returns (that answer's clocks after the first's request,
+    less P; the data the access read)."""
+    (reg1, v1, sel1), (reg2, v2, sel2) = first, second
+    await at_phase(dut, p, phase)
+    w, _, _ = await raw.access(addr(reg1, k), v1, sel=sel1)
+    s, got, _ = await raw.access(addr(reg2, k), v2, sel=sel2)
+    done = int(raw.tb.value)
+    what = "read" if v2 is None else "write"
+    if env.engine:
+        assert done - w <= p + bound, \
+            f"channel {k}: a {reg2} {what} right after a {reg1} write answered {done - w} clocks " \
+            f"after the write's request (bound P + {bound}, P {p})"
+    else:
+        assert done - s == PER_CHANNEL_ANSWER, f"{reg2} {what}: answered {done - s} clocks"
+    return done - w - p, got
+
+
 @cocotb_test()
 async def read_after_write_wait(dut):
     """A write of a channel, then at once a read of the same register (it must see the write),
@@ -493,18 +515,10 @@ async def read_after_write_wait(dut):
             k = rng.randrange(n)
             old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
             value = (old & ~mask) | (rng.getrandbits(32) & mask)
-            await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
-            w, _, _ = await raw.access(addr(reg, k), value, sel=sel)
-            r, got, _ = await raw.access(addr(reg, k))
-            done = int(raw.tb.value)
+            late, got = await after_write(dut, raw, env, p, (rel + (p // max(n, 2)) * k) % p, k,
+                                          (reg, value, sel), (reg, None, 0xF), bound)
             assert got == value, f"channel {k}: {reg} written {value:#x}, read right after: {got:#x}"
-            if env.engine:
-                assert done - w <= p + bound, \
-                    f"channel {k}: {reg} read right after a write answered {done - w} clocks after " \
-                    f"the write's request (bound P + {bound}, P {p})"
-            else:
-                assert done - r == PER_CHANNEL_ANSWER, f"{reg}: read answered {done - r} clocks"
-            worst[reg] = max(worst[reg], done - w - p)
+            worst[reg] = max(worst[reg], late)
             await ClockCycles(dut.clk, p + ENGINE_WAIT)
         dut._log.info("a read of %s right after a write answered at worst P + %d clocks after the "
                       "write's request (bound P + %d, P %d)", reg, worst[reg], bound, p)
@@ -548,17 +562,9 @@ async def write_after_write_wait(dut):
             v2 = await value_for(second, sel2, k)
             if first == second:
                 v2 ^= 1  # (the read must tell the second from the first)
-            await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
-            w, _, _ = await raw.access(addr(first, k), v1, sel=sel1)
-            s, _, _ = await raw.access(addr(second, k), v2, sel=sel2)
-            done = int(raw.tb.value)
-            if env.engine:
-                assert done - w <= p + bound, \
-                    f"channel {k}: a {second} write right after a {first} write answered " \
-                    f"{done - w} clocks after the first's request (bound P + {bound}, P {p})"
-            else:
-                assert done - s == PER_CHANNEL_ANSWER, f"{second}: answered {done - s} clocks"
-            worst = max(worst, done - w - p)
+            late, _ = await after_write(dut, raw, env, p, (rel + (p // max(n, 2)) * k) % p, k,
+                                        (first, v1, sel1), (second, v2, sel2), bound)
+            worst = max(worst, late)
             got1 = (await raw.access(addr(first, k)))[1]
             got2 = (await raw.access(addr(second, k)))[1]
             assert got2 == v2, f"channel {k}: {second} written {v2:#x} second, reads {got2:#x}"
