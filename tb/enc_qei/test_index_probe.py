@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei index and probe: INDEX_CTRL actions (preset, latch, none), the gate, one-shot, edges,
 the latches with wide values, index edges at steps and wraps; PROBE_CTRL, PROBE_LATCH and
-PROBE_TIME; which configuration changes are not index edges. A lean build has no probe unit and a
+PROBE_TIME; which configuration changes are not index edges, and that a gate change is one. A lean build has no probe unit and a
 free-running count: its index tests run in the free range (wraps at 0 and the top).
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
@@ -368,6 +368,58 @@ async def ctrl_change_is_not_an_index_edge(dut):
             got = await latch()
             assert got == count2, f"{what}: INDEX_LATCH {got:#x} after the Z edge, count {count2:#x}"
     await bus.wr("INDEX_CTRL", 0)
+
+
+@cocotb_test()
+async def gate_change_is_an_index_edge(dut):
+    """An INDEX_CTRL write that changes the gate (GATE_EN, or GATE_A / GATE_B) with Z high and A, B
+    still changes the qualified index, and that change is an index edge (the RDL): armed in the
+    same write, it raises INDEX and performs ACTION (preset: COUNT = PRESET); written with ARM = 0
+    it raises INDEX only, and arming after it does nothing more. Either direction, for the EDGE
+    that the change makes; a change that makes the other edge raises nothing."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0, filter_len=1)
+    await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+    ab = QUAD[env.pos % 4]
+    other = QUAD[(env.pos + 2) % 4]  # a state the shaft is not in
+    preset = 0x3A5 & model.max
+    await bus.set64("PRESET", preset)
+    dut.z_in.value = 1
+
+    def gate(on, state):
+        return dict(GATE_EN=on, GATE_A=state[0], GATE_B=state[1])
+
+    # (before, after, the edge it makes): qualified index 0 -> 1 is rising, 1 -> 0 falling
+    changes = [(gate(1, other), gate(0, other), "rising"), (gate(1, other), gate(1, ab), "rising"),
+               (gate(0, other), gate(1, other), "falling"), (gate(1, ab), gate(1, other), "falling")]
+    for k, (g0, g1, made) in enumerate(changes):
+        for edge in ("rising", "falling"):
+            for arm in (1, 0):
+                what = f"gate {g0} -> {g1} ({made} edge), EDGE {edge}, ARM {arm} in the write"
+                count = 0x100 + 0x20 * k
+                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=0, **g0))
+                await bus.set_count(count)
+                await env.applied()
+                await env.settle(4)
+                await bus.events()
+                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=arm, **g1))
+                await env.applied()
+                await env.settle(4)
+                if not arm:
+                    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=1,
+                                                    **g1))
+                    await env.applied()
+                    await env.settle(4)
+                ev = await bus.events()
+                got = await bus.count()
+                acts = edge == made
+                assert ("INDEX" in ev) == acts, f"{what}: events {sorted(ev)}"
+                want = preset if acts and arm else count
+                assert got == want, f"{what}: COUNT {got:#x}, wanted {want:#x}"
+    await bus.wr("INDEX_CTRL", 0)
+    dut.z_in.value = 0
 
 
 @cocotb_test()

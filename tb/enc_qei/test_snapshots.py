@@ -233,6 +233,53 @@ async def unit_timer_period(dut):
     await bus.wr("TB_PRESCALE", 0)
 
 
+@cocotb_test(skip=lacks("PERIOD") or not engine_build())
+async def unit_timer_faster_than_the_engine(dut):
+    """The shared engine: SNAP_PERIOD below P (0, 1, 5, P / 2, P - 1) with PERIOD_EN, a request at
+    least every P - 1 ticks: once one request has waited for a read, every later one waits too,
+    and the channel takes one snapshot per read, SNAP_TIME values exactly P ticks apart (the RDL,
+    CAPS.ENGINE shared (3)). Before that (SNAP_PERIOD near P: the timer's grid drifts against the
+    reads by P - SNAP_PERIOD a period) the snapshots are SNAP_PERIOD apart. SNAP_TIME is polled
+    every few clocks, so no value is missed; the regime must start within P + 2 periods."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    p = engine_period(int(dut.CHANNELS.value))
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    for sp in (0, 1, 5, p // 2, p - 1):
+        step = max(sp, 1)
+        await bus.wr("SNAP_PERIOD", sp)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+        await env.applied()
+        seen = [await bus.rd("SNAP_TIME")]
+        gaps = []
+        waited = False
+        limit = (p + 2) * step + 4 * p
+        start = get_sim_time("ns") / T_NS
+        while len(gaps) < 6:
+            t = await bus.rd("SNAP_TIME")
+            if t == seen[-1]:
+                assert get_sim_time("ns") / T_NS - start < limit + 10 * p, \
+                    f"SNAP_PERIOD {sp}: SNAP_TIME stopped at {t:#x}"
+                continue
+            gap = (t - seen[-1]) & ts_mask
+            seen.append(t)
+            if len(seen) == 2:
+                continue  # (from the value before the timer)
+            if waited:
+                gaps.append(gap)
+            elif gap != step:
+                # the first snapshot that waited for a read: at most P after the one before
+                assert 0 < gap <= p, f"SNAP_PERIOD {sp}: snapshots {[hex(x) for x in seen]}"
+                waited = True
+            else:
+                assert get_sim_time("ns") / T_NS - start < limit, \
+                    f"SNAP_PERIOD {sp}: no snapshot waited for a read in {limit} clocks"
+        assert set(gaps) == {p}, f"SNAP_PERIOD {sp}: once one waited, snapshots {gaps} apart, not " \
+                                 f"one at each read, every P = {p}"
+        await bus.wr("SNAP_CTRL", 0)
+        await env.applied()
+
+
 @cocotb_test()
 async def snapshot_wide_values(dut):
     """SNAP_COUNT of counts with every bit pattern (the high half too): a snapshot holds them;
