@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei index and probe: INDEX_CTRL actions (preset, latch, none), the gate, one-shot, edges,
 the latches with wide values, index edges at steps and wraps; PROBE_CTRL, PROBE_LATCH and
-PROBE_TIME; which configuration changes are not index edges, and that a gate change is one. A lean build has no probe unit and a
-free-running count: its index tests run in the free range (wraps at 0 and the top).
+PROBE_TIME; which configuration changes are not index edges, and that a gate change is one. A
+lean build has no probe unit and a free-running count: its index tests run in the free range
+(wraps at 0 and the top).
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -392,24 +393,29 @@ async def gate_change_is_an_index_edge(dut):
         return dict(GATE_EN=on, GATE_A=state[0], GATE_B=state[1])
 
     # (before, after, the edge it makes): qualified index 0 -> 1 is rising, 1 -> 0 falling
-    changes = [(gate(1, other), gate(0, other), "rising"), (gate(1, other), gate(1, ab), "rising"),
-               (gate(0, other), gate(1, other), "falling"), (gate(1, ab), gate(1, other), "falling")]
+    changes = [(gate(1, other), gate(0, other), "rising"),
+               (gate(1, other), gate(1, ab), "rising"),
+               (gate(0, other), gate(1, other), "falling"),
+               (gate(1, ab), gate(1, other), "falling")]
+
+    def index_ctrl(g, edge, arm):
+        return pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=arm, **g)
+
     for k, (g0, g1, made) in enumerate(changes):
         for edge in ("rising", "falling"):
             for arm in (1, 0):
                 what = f"gate {g0} -> {g1} ({made} edge), EDGE {edge}, ARM {arm} in the write"
                 count = 0x100 + 0x20 * k
-                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=0, **g0))
+                await bus.wr("INDEX_CTRL", index_ctrl(g0, edge, 0))
                 await bus.set_count(count)
                 await env.applied()
                 await env.settle(4)
                 await bus.events()
-                await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=arm, **g1))
+                await bus.wr("INDEX_CTRL", index_ctrl(g1, edge, arm))
                 await env.applied()
                 await env.settle(4)
                 if not arm:
-                    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE=edge, ARM=1,
-                                                    **g1))
+                    await bus.wr("INDEX_CTRL", index_ctrl(g1, edge, 1))
                     await env.applied()
                     await env.settle(4)
                 ev = await bus.events()
