@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """enc_qei timebase and timing unit: TIMEBASE and TB_PRESCALE, PERIOD capture (N edges,
-direction change, overflow, held values), STALL_TIMEOUT and STATUS.STALLED. A lean build has the
-timebase but no period capture or stall unit: it runs the timebase's tests only.
+direction change, overflow, held values), STALL_TIMEOUT (a rewrite too) and STATUS.STALLED. A
+lean build has the timebase but no period capture or stall unit: it runs the timebase's tests
+only.
 
 Runs on both builds of enctools.qei.env.CONFIGS (enc_qei_wb, cocotbext-wishbone; enc_qei_axil,
 cocotbext-axi with random back-pressure), shared with the other feature files of tb/enc_qei/.
@@ -191,6 +192,49 @@ async def stall_and_recovery(dut):
         assert not (await bus.rd("STATUS")) >> stalled_lsb & 1, "STALLED not cleared by an edge"
     await bus.wr("STALL_TIMEOUT", 0)
     await bus.wr("TB_PRESCALE", 0)
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def stall_timeout_rewrite(dut):
+    """A channel stalled (STATUS.STALLED, STALL raised): writing STALL_TIMEOUT with the value it
+    has changes nothing (STALLED stays, no second STALL); a different value clears STALLED and
+    restarts the timeout, so that with the shaft still STALL comes again that many ticks later,
+    not before (the RDL)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0)
+    stalled_lsb = regmap()["STATUS"].fields["STALLED"].lsb
+
+    async def stalled() -> int:
+        return (await bus.rd("STATUS")) >> stalled_lsb & 1
+
+    t1, t2 = 200, 700 + env.lag
+    await bus.wr("STALL_TIMEOUT", t1)
+    await env.applied()
+    await env.play(walk([1] * 4, durations(rng, 4), start_pos=env.pos), None)
+    await ClockCycles(dut.clk, t1 + 50)
+    await env.settle()
+    assert await stalled(), "no stall after the timeout"
+    await bus.events()
+    await bus.wr("STALL_TIMEOUT", t1)  # the value it has
+    await env.applied()
+    await env.settle()
+    assert await stalled(), "STALL_TIMEOUT written with its own value cleared STALLED"
+    assert "STALL" not in await bus.events(), "STALL_TIMEOUT written with its own value: STALL again"
+    await bus.wr("STALL_TIMEOUT", t2)  # a new value
+    await env.applied()
+    await env.settle()
+    assert not await stalled(), "a new STALL_TIMEOUT did not clear STALLED"
+    assert "STALL" not in await bus.events(), "a new STALL_TIMEOUT raised STALL at once"
+    await ClockCycles(dut.clk, t2 - 2 * env.lag - 100)
+    assert "STALL" not in await bus.events() and not await stalled(), \
+        "STALL again before the new timeout"
+    await ClockCycles(dut.clk, 2 * env.lag + 200)
+    await env.settle()
+    assert "STALL" in await bus.events() and await stalled(), \
+        f"no STALL {t2} ticks after the new STALL_TIMEOUT"
+    await bus.wr("STALL_TIMEOUT", 0)
 
 
 @cocotb_test(skip=lacks("PERIOD"))
