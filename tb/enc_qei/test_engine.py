@@ -472,6 +472,17 @@ async def write_effect(dut):
             f"channel {k}: COUNT_LO {old:#x}, written {new:#x} with byte enables {strb:#x}: {got:#x}"
 
 
+# the bits of a register the wait tests write (COUNT_LO: byte lanes 0 and 1, IRQ_EN: its events)
+WRITE_MASK = {"PRESET_LO": 0xFFFFFFFF, "COUNT_LO": 0xFFFF, "IRQ_EN": 0x3FF}
+
+
+async def random_value(raw: WbRaw, rng, reg: str, k: int, sel: int) -> int:
+    """A random value of reg for channel k in its WRITE_MASK bits; the other bits as the register
+    reads now when the write keeps some byte lanes (sel not 0xF), else 0."""
+    old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
+    return (old & ~WRITE_MASK[reg]) | (rng.getrandbits(32) & WRITE_MASK[reg])
+
+
 async def after_write(dut, raw: WbRaw, env, p: int, phase: int, k: int, first: tuple,
                       second: tuple, bound: int) -> tuple[int, int]:
     """At the phase of channel k's visits: a write of first = (register, value, byte enables),
@@ -507,14 +518,12 @@ async def read_after_write_wait(dut):
     raw = WbRaw(dut)
     p = engine_period(n) if env.engine else 2
     worst = {}
-    for reg, mask, sel, bound in (("PRESET_LO", 0xFFFFFFFF, 0xF, ENGINE_WAIT),
-                                  ("COUNT_LO", 0xFFFF, 0x3, ENGINE_PART_WAIT),
-                                  ("IRQ_EN", 0x3FF, 0xF, ENGINE_STATE_WAIT)):
+    for reg, sel, bound in (("PRESET_LO", 0xF, ENGINE_WAIT), ("COUNT_LO", 0x3, ENGINE_PART_WAIT),
+                            ("IRQ_EN", 0xF, ENGINE_STATE_WAIT)):
         worst[reg] = 0
         for rel in range(p):
             k = rng.randrange(n)
-            old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
-            value = (old & ~mask) | (rng.getrandbits(32) & mask)
+            value = await random_value(raw, rng, reg, k, sel)
             late, got = await after_write(dut, raw, env, p, (rel + (p // max(n, 2)) * k) % p, k,
                                           (reg, value, sel), (reg, None, 0xF), bound)
             assert got == value, f"channel {k}: {reg} written {value:#x}, read right after: {got:#x}"
@@ -548,18 +557,13 @@ async def write_after_write_wait(dut):
              ("COUNT_LO", 0x3, "PRESET_LO", 0xF, ENGINE_WRITE_PART_WAIT),
              ("IRQ_EN", 0xF, "IRQ_EN", 0xF, ENGINE_WRITE_STATE_WAIT),
              ("PRESET_LO", 0xF, "COUNT_LO", 0x3, ENGINE_WRITE_WAIT + 2))
-    masks = {"PRESET_LO": 0xFFFFFFFF, "COUNT_LO": 0xFFFF, "IRQ_EN": 0x3FF}
-
-    async def value_for(reg, sel, k):
-        old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
-        return (old & ~masks[reg]) | (rng.getrandbits(32) & masks[reg])
 
     for first, sel1, second, sel2, bound in cases:
         worst = 0
         for rel in range(p):
             k = rng.randrange(n)
-            v1 = await value_for(first, sel1, k)
-            v2 = await value_for(second, sel2, k)
+            v1 = await random_value(raw, rng, first, k, sel1)
+            v2 = await random_value(raw, rng, second, k, sel2)
             if first == second:
                 v2 ^= 1  # (the read must tell the second from the first)
             late, _ = await after_write(dut, raw, env, p, (rel + (p // max(n, 2)) * k) % p, k,
@@ -605,16 +609,16 @@ async def no_wait_after_store(dut):
     p = engine_period(n) if env.engine else 2
     want = ENGINE_READ_ANSWER if env.engine else PER_CHANNEL_ANSWER
     tight = env.engine and p <= 72
-    cases = (("PRESET_LO", 0xF, 0xFFFFFFFF, ENGINE_NO_WAIT), ("COUNT_LO", 0x3, 0xFFFF, ENGINE_NO_WAIT),
-             ("IRQ_EN", 0xF, 0x3FF, ENGINE_STATE_NO_WAIT))
-    for reg, sel, mask, bound in (cases if p <= 72 else cases[::2]):
+    cases = (("PRESET_LO", 0xF, ENGINE_NO_WAIT), ("COUNT_LO", 0x3, ENGINE_NO_WAIT),
+             ("IRQ_EN", 0xF, ENGINE_STATE_NO_WAIT))
+    for reg, sel, bound in (cases if p <= 72 else cases[::2]):
         waited = 0
         for rel in range(p):
             for early in ((0, 1) if tight else (0,)):
                 k = rng.randrange(n)
-                old = (await raw.access(addr(reg, k)))[1] if sel != 0xF else 0
+                value = await random_value(raw, rng, reg, k, sel)
                 await at_phase(dut, p, (rel + (p // max(n, 2)) * k) % p)
-                await raw.access(addr(reg, k), (old & ~mask) | (rng.getrandbits(32) & mask), sel=sel)
+                await raw.access(addr(reg, k), value, sel=sel)
                 answer = int(raw.tb.value)
                 at = answer + (p + bound - early if env.engine else 3)
                 while int(raw.tb.value) < at - 1:
