@@ -17,7 +17,7 @@ from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
 from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, channel, engine_lag, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, caps_of, channel, engine_lag, run_feature
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations
 from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
@@ -146,15 +146,17 @@ async def byte_enables(dut):
 
 @cocotb_test()
 async def register_walk(dut):
-    """Every register of the compiled RDL through the bus: offset, reset value, access. On the
-    shared engine a write acts, and a snapshot it requests (GSNAP_CTRL, SNAP_CTRL, their timers)
-    is taken, up to engine_lag clocks later: the walk waits that long after each register, so
-    that a read-only register (GSNAP_TIME, SNAP_*) it reads next holds still."""
+    """Every register of the compiled RDL through the bus: CAPS equal to the build's parameters
+    (every field, the feature bits included), offset, reset value, access. On the shared engine
+    a write acts, and a snapshot it requests (GSNAP_CTRL, SNAP_CTRL, their timers) is taken, up
+    to engine_lag clocks later: the walk waits that long after each register, so that a
+    read-only register (GSNAP_TIME, SNAP_*) it reads next holds still."""
     env, rng = await begin(dut)
     bus = env.bus
     caps = await bus.rd("CAPS")
     count_w, ts_w = caps & 0xFF, caps >> 8 & 0xFF
-    assert (count_w, ts_w) == (env.count_w, int(dut.TS_W.value)), f"CAPS {caps:#x}"
+    # every field of CAPS (the feature bits INDEX, PROBE, TIMING too) as the build's parameters give it
+    assert caps == caps_of(dut), f"CAPS {caps:#010x}, the build's {caps_of(dut):#010x}"
     regs = sorted(regmap().values(), key=lambda r: r.offset)
     have = units(caps)
     settle = engine_lag(int(dut.CHANNELS.value)) if env.engine else 0

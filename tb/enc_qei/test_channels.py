@@ -20,7 +20,8 @@ from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus, wb_abandon_read
-from enctools.qei.env import FILTER, begin, build_name, channel_envs, engine_build, engine_period
+from enctools.qei.env import (FILTER, begin, build_name, caps_of, channel_envs, engine_build,
+                              engine_period)
 from enctools.qei.model import QUAD_FUNCS, QeiModel
 from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import PAGE, addr, built_mask, enum, get_field, pack, regmap, units
@@ -228,6 +229,7 @@ async def channel_map(dut):
     n = channels_of(dut)
     caps = await bus.rd("CAPS")
     assert get_field("CAPS", "CHANNELS", caps) == n, f"CAPS {caps:#x}: CHANNELS is not {n}"
+    assert caps == caps_of(dut), f"CAPS {caps:#010x}, the build's {caps_of(dut):#010x}"
     profile = {v: k for k, v in enum("CAPS", "PROFILE").items()}[get_field("CAPS", "PROFILE", caps)]
     assert profile == PROFILE_OF[int(dut.PROFILE.value)], f"CAPS.PROFILE {profile}"
     arch = {v: k for k, v in enum("CAPS", "ENGINE").items()}[get_field("CAPS", "ENGINE", caps)]

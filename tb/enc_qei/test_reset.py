@@ -11,14 +11,18 @@ Every cocotb test logs its seed (make test SEED=n reproduces a run).
 from __future__ import annotations
 
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, engine_period, run_feature
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, ENGINE_SHOW, begin, engine_period, lacks,
+                              run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, pulse_rst
-from enctools.regmap import built_mask, pack, regmap, units
+from enctools.regmap import built_mask, field, pack, regmap, units
 from enctools.tb import cocotb_test
+
+
+FILTER_RESET = regmap()["CTRL"].fields["FILTER_LEN"].reset  # CTRL.FILTER_LEN after reset (3)
 
 
 @cocotb_test()
@@ -180,6 +184,69 @@ async def irq_low_in_reset(dut):
     for k in range(6):
         await FallingEdge(dut.clk)
         assert dut.irq.value == 0, f"irq high {k} clocks after the reset"
+
+
+@cocotb_test(skip=lacks("RANGE"))
+async def cmp_out_low_in_reset(dut):
+    """cmp_out is 0 from the first clock of a reset on and after it (compare is off after reset:
+    CTRL.CMP_EN 0), with a step onto an armed COMPARE reaching the pins in any clock from 4
+    before rst to 9 after it; with the step well before the reset, cmp_out pulses first (so the
+    compare was armed)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for off in range(-4, 10):  # rst rises `off` clocks after the step reaches the pins
+        await env.setup(QeiModel(env.count_w), count=5, compare=6, filter_len=1)
+        a, b = QUAD[(env.pos + 1) % 4]
+        trace = []  # per clock: rst as the edge sampled it, cmp_out after the edge
+        for k in range(-6, 24):
+            await FallingEdge(dut.clk)
+            if k == 0:
+                dut.a_in.value, dut.b_in.value = a, b
+            if k == off:
+                dut.rst.value = 1
+            if k == off + 2:
+                dut.rst.value = 0
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            trace.append((k, int(dut.rst.value), int(dut.cmp_out.value)))
+        env.pos += 1
+        first = next(i for i, (_, r, _) in enumerate(trace) if r)
+        late = [k for k, _, c in trace[first:] if c]
+        assert not late, f"rst {off} clocks after the step: cmp_out high in clocks {late} (of the step)"
+        if off == 9:
+            assert any(c for _, _, c in trace[:first]), "the step onto COMPARE gave no cmp_out"
+        await env.settle(20)
+    assert await bus.rd("CTRL") & field("CTRL", "CMP_EN").mask == 0, "CMP_EN not 0 after reset"
+
+
+@cocotb_test()
+async def status_after_reset(dut):
+    """STATUS right after a reset: DIR (the direction of the last step) reads 1 (up) however
+    the steps before the reset went, from the first read on; VALID (the filter settled, FILTER_LEN
+    + 2 clocks after rst) reads 0 in a read requested in the clock rst falls, then 1, never back
+    to 0: for each d, one reset after a step down and one read requested d clocks after it, d = 0
+    .. 12 on a per_channel build (1 from FILTER_LEN + 2 = 5), d = 0 .. P + 56 on the shared
+    engine (1 from P + 44 + 5: CAPS.ENGINE shared (1))."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    settled = FILTER_RESET + 2 + (engine_period(int(dut.CHANNELS.value)) + ENGINE_SHOW
+                                  if env.engine else 0)
+    valid = []
+    for d in range(settled + 8):
+        await env.play(walk([-1], [30.0], start_pos=env.pos), None)
+        if d % 8 == 0:  # (the step down shows in DIR: the reset has something to undo)
+            assert not await bus.rd("STATUS") & field("STATUS", "DIR").mask, "DIR 1 after a step down"
+        await pulse_rst(dut, 2)
+        if d:
+            await ClockCycles(dut.clk, d)
+        status = await bus.rd("STATUS")
+        assert status & field("STATUS", "DIR").mask, f"STATUS {status:#x} read {d} clocks after rst: DIR 0"
+        valid.append(int(bool(status & field("STATUS", "VALID").mask)))
+        await env.settle(20)
+    dut._log.info("STATUS.VALID in reads d = 0, 1, ... clocks after rst: %s", "".join(map(str, valid)))
+    assert valid[0] == 0, "STATUS.VALID 1 in a read requested in the clock rst fell"
+    assert valid == sorted(valid), f"STATUS.VALID went back to 0 (reads d = 0, 1, ...: {valid})"
+    assert all(valid[settled:]), f"STATUS.VALID 0 in a read {valid.index(0, settled)} clocks after rst"
 
 
 @cocotb_test(timeout_time=12, timeout_unit="ms")  # about 3.6 ms on the engine: 3x, for mutation

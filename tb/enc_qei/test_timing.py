@@ -79,8 +79,8 @@ async def prescaler_and_snap_in(dut):
 @cocotb_test(skip=lacks("PERIOD"))
 async def period_capture(dut):
     """PERIOD over N edges at constant speed (measurements of an even and of an odd number of
-    clocks), the direction-change flag, PERIOD_READY, and the overflow flag and PERIOD_OVF event
-    (TS_W = 16 builds only: 65,536 ticks)."""
+    clocks), the direction-change flag, PERIOD_READY, and the overflow flag and PERIOD_OVF event,
+    taken through IRQ_EN, irq and its W1C (TS_W = 16 builds only: 65,536 ticks)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -116,9 +116,29 @@ async def period_capture(dut):
     ctrl = await bus.rd("PERIOD_CTRL")
     assert ctrl >> lsb["DIR_CHANGE"].lsb & 1, "a reversal inside the measurement did not set DIR_CHANGE"
     if int(dut.TS_W.value) == 16:
+        # PERIOD_OVF through IRQ_EN and irq: masked, then enabled alone; a W1C of another event
+        # keeps it, its own W1C clears it and irq falls
+        ovf = event_bits("PERIOD_OVF")
+        await bus.wr("IRQ_EN", ~ovf & 0xFFFF)
         await bus.events()
+        await env.applied()
         await env.settle(65540)
-        assert "PERIOD_OVF" in await bus.events()
+        word = await bus.rd("EVENTS")
+        assert word & ovf, f"no PERIOD_OVF after 65,540 ticks (EVENTS {word:#x})"
+        await env.settle(3)
+        assert dut.irq.value == int(bool(word & ~ovf & 0xFFFF)), "irq follows the masked PERIOD_OVF"
+        await bus.wr("EVENTS", word & ~ovf)  # every other event: PERIOD_OVF stays
+        await bus.wr("IRQ_EN", ovf)
+        await env.applied()
+        await env.settle(3)
+        assert await bus.rd("EVENTS") & ovf, "a W1C of the other events cleared PERIOD_OVF"
+        assert dut.irq.value == 1, "irq low with PERIOD_OVF pending and enabled"
+        await bus.wr("EVENTS", ovf)
+        await env.applied()
+        await env.settle(3)
+        assert not await bus.rd("EVENTS") & ovf, "the W1C of PERIOD_OVF did not clear it"
+        assert dut.irq.value == 0, "irq still high after PERIOD_OVF was cleared"
+        await bus.wr("IRQ_EN", 0)
         wf = walk([1] * 9, [6 * T_NS] * 9, start_pos=env.pos)
         await env.play(wf, None)
         ctrl = await bus.rd("PERIOD_CTRL")
@@ -234,6 +254,36 @@ async def stall_timeout_rewrite(dut):
     assert "STALL" in await bus.events() and await stalled(bus), \
         f"no STALL {t2} ticks after the new STALL_TIMEOUT"
     await bus.wr("STALL_TIMEOUT", 0)
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def stall_timeout_zero_is_off(dut):
+    """STALL_TIMEOUT 0 is off (the RDL): from reset, a stop longer than the timebase's wrap on a
+    TS_W 16 build (3,000 clocks at TS_W 32) raises no STALL and leaves STATUS.STALLED 0; written
+    0 while stalled (a new value), it clears STALLED and no STALL comes again."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0)
+    stop = (1 << 16) + 500 if int(dut.TS_W.value) == 16 else 3000
+    await env.play(walk([1] * 4, durations(rng, 4), start_pos=env.pos), None)
+    await bus.events()
+    await ClockCycles(dut.clk, stop)
+    await env.settle()
+    assert not await stalled(bus), f"STALL_TIMEOUT 0 (reset): STALLED after {stop} clocks"
+    assert "STALL" not in await bus.events(), f"STALL_TIMEOUT 0 (reset): STALL within {stop} clocks"
+    await bus.wr("STALL_TIMEOUT", 100)
+    await env.applied()
+    await ClockCycles(dut.clk, 150)
+    await env.settle()
+    assert await stalled(bus) and "STALL" in await bus.events(), "no stall 150 ticks after a timeout of 100"
+    await bus.wr("STALL_TIMEOUT", 0)
+    await env.applied()
+    await env.settle()
+    assert not await stalled(bus), "STALL_TIMEOUT written 0 while stalled: STALLED stays"
+    await ClockCycles(dut.clk, 3000)
+    await env.settle()
+    assert not await stalled(bus) and "STALL" not in await bus.events(), \
+        "STALL_TIMEOUT written 0 while stalled: a stall followed"
 
 
 @cocotb_test(skip=lacks("PERIOD"))

@@ -91,6 +91,19 @@ class Timebase:
                 return
 
 
+def caps_of(dut) -> int:
+    """The CAPS word the RDL gives the build being simulated, from its parameters alone: INDEX 1;
+    PROBE with the counting and full profiles, TIMING with full and lean (the profile enum's
+    descriptions); the widths, CHANNELS, EFIFO_LOG2 and ENGINE as built. Written out here, not
+    taken from enctools.regmap.units, which reads the units from a CAPS word."""
+    profile = {v: k for k, v in PROFILES.items()}[int(dut.PROFILE.value)]
+    return pack("CAPS", COUNT_W=int(dut.COUNT_W.value), TS_W=int(dut.TS_W.value), INDEX=1,
+                PROBE=int(profile in ("counting", "full")), TIMING=int(profile in ("full", "lean")),
+                PROFILE=profile, CHANNELS=int(dut.CHANNELS.value),
+                EFIFO_LOG2=int(dut.EFIFO_LOG2.value) if hasattr(dut, "EFIFO_LOG2") else 0,
+                ENGINE="shared" if int(dut.ENGINE.value) else "per_channel")
+
+
 def engine_lag(channels: int) -> int:
     """The clocks a test waits for the shared engine to show what happened before (a step in
     COUNT, an event in EVENTS, a snapshot in SNAP_*, a write acting): more than every bound
