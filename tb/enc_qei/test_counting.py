@@ -11,13 +11,14 @@ Every cocotb test logs its seed (make test SEED=n reproduces a run).
 from __future__ import annotations
 
 import pytest
+from cocotb.triggers import Timer
 from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
 
-from enctools.qei.bus import T_NS
+from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
 from enctools.qei.model import FUNCS, QeiModel
 from enctools.qei.stimulus import BURST, ceilings, durations, near, steps_from, walk_with_jumps
-from enctools.regmap import get_field, pack, regmap
+from enctools.regmap import get_field, pack, regmap, units
 from enctools.tb import cocotb_test
 
 
@@ -277,6 +278,62 @@ async def en_off_gates_steps_only(dut):
         model.write_count(value)
         await env.settle()
         await env.check(model, f"EN 0, COUNT write after index pulse {k + 1}")
+
+
+@cocotb_test()
+async def en_off_keeps_the_rest(dut):
+    """CTRL.EN = 0 gates the steps only; the rest keeps working (the RDL's EN): illegal jumps
+    raise QERR and count in QERR_COUNT, rejected pulses raise GLITCH and count in GLITCH_COUNT,
+    TIMEBASE advances, a probe edge latches the count into PROBE_LATCH with PROBE_TIME between
+    the TIMEBASE reads around it and raises PROBE, and a COUNT write onto COMPARE raises CMP
+    (the units a build has); COUNT stays the value written."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    have = units(await bus.rd("CAPS"))
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    model = QeiModel(env.count_w)
+    count = 0x0000_0002_8000_0123 & model.max
+    await env.setup(model, count=count, en=0, filter_len=3,
+                    compare=None if "RANGE" not in have else count + 7)
+    n_q, n_g = rng.randint(3, 9), rng.randint(3, 9)
+    await env.play(walk([2] * n_q, [6 * T_NS] * n_q, start_pos=env.pos), None)
+    for _ in range(n_g):  # lone pulses of 1.5 clocks on A: shorter than FILTER_LEN 3
+        a = QUAD[env.pos % 4][0]
+        dut.a_in.value = 1 - a
+        await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")
+        dut.a_in.value = a
+        await Timer(8 * T_NS, unit="ns")
+    await env.settle()
+    q, g = await bus.rd("QERR_COUNT"), await bus.rd("GLITCH_COUNT")
+    assert q == n_q, f"EN 0: QERR_COUNT {q} after {n_q} illegal jumps"
+    assert g == n_g, f"EN 0: GLITCH_COUNT {g} after {n_g} rejected pulses"
+    ev = await bus.events()
+    assert {"QERR", "GLITCH"} <= ev, f"EN 0: EVENTS {sorted(ev)} without QERR and GLITCH"
+    assert await bus.count() == count, "EN 0: COUNT moved"
+    t0 = await bus.rd("TIMEBASE")
+    await Timer(50 * T_NS, unit="ns")
+    t1 = await bus.rd("TIMEBASE")
+    assert (t1 - t0) & ts_mask >= 50, f"EN 0: TIMEBASE {t0:#x} -> {t1:#x} in 50 clocks"
+    if "PROBE" in have:
+        await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1))
+        await env.applied()
+        before = await bus.rd("TIMEBASE")
+        dut.probe_in.value = 1
+        await env.settle(8)
+        dut.probe_in.value = 0
+        after = await bus.rd("TIMEBASE")
+        latch = await bus.get64("PROBE_LATCH")
+        t_probe = await bus.rd("PROBE_TIME")
+        assert latch == count, f"EN 0: PROBE_LATCH {latch:#x}, count {count:#x}"
+        assert 0 < (t_probe - before) & ts_mask < (after - before) & ts_mask, \
+            f"EN 0: PROBE_TIME {t_probe:#x} not between TIMEBASE {before:#x} and {after:#x}"
+        assert "PROBE" in await bus.events(), "EN 0: a probe edge raised no PROBE"
+    if "RANGE" in have:
+        await bus.set_count(count + 7)
+        await env.applied()
+        await env.settle()
+        assert "CMP" in await bus.events(), "EN 0: a COUNT write onto COMPARE raised no CMP"
+    await bus.wr("PROBE_CTRL", 0)
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

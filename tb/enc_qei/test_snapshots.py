@@ -537,6 +537,43 @@ async def snapshot_deltas_backward(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
+def built_count_w() -> int:
+    """COUNT_W of the build being simulated (64 outside a simulation: pytest collecting)."""
+    top = getattr(cocotb, "top", None)
+    return int(top.COUNT_W.value) if top is not None else 64
+
+
+@cocotb_test(skip=built_count_w() <= 32)
+async def snapshot_count_across_bit_32(dut):
+    """COUNT_W > 32: the count crosses bit 32 between two snapshots, up (a carry into the high
+    word) and down (a borrow from it), and the top of the range (2^64 - 1 to 0 and back): each
+    SNAP_COUNT_LO / SNAP_COUNT_HI pair is the model's count, SNAP_DELTA and SNAP_EDGE_DELTA
+    (EDGE any) the steps between the snapshots, COUNT_LO / COUNT_HI the count."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    for base in (0x0000_0000_FFFF_FFE0, 0x1234_5678_0000_0010, model.max - 0x18):
+        await env.setup(model, count=base, filter_len=1)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        model.delta = 0
+        for n, way in ((rng.randint(40, 70), 1), (rng.randint(80, 140), -1), (rng.randint(60, 90), 1)):
+            wf = walk([way] * n, durations(rng, n, f=1), start_pos=env.pos)
+            await env.play(wf, model)
+            await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+            await env.settle(4)
+            snap = await read_snapshot(bus)
+            got = snap["count_hi"] << 32 | snap["count"]
+            what = f"from {base:#x}, {n} x {way:+d}"
+            assert got == model.count, f"{what}: SNAP_COUNT {got:#x}, model {model.count:#x}"
+            assert signed(snap["delta"]) == model.delta == signed(snap["edge_delta"]), \
+                f"{what}: SNAP_DELTA {signed(snap['delta'])}, SNAP_EDGE_DELTA " \
+                f"{signed(snap['edge_delta'])}, model {model.delta}"
+            assert await bus.count() == model.count, f"{what}: COUNT, model {model.count:#x}"
+            model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
 @cocotb_test()
 async def edge_time_across_count_writes(dut):
     """A COUNT_LO write leaves the filters' FILTER_LEN alone in every clock: FILTER_LEN 3, then
