@@ -13,11 +13,12 @@ from __future__ import annotations
 import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
-from hedsmodel import walk
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
+from hedsmodel import QUAD, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
-from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, caps_of, channel, engine_lag, run_feature
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, begin, caps_of, channel, engine_build, engine_lag,
+                              run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations
 from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
@@ -252,6 +253,117 @@ async def register_patterns(dut):
     for r in regs:  # back to the reset values
         await bus.wr(r.name, sum((f.reset or 0) << f.lsb for f in r.fields.values()) & 0xFFFFFFFF)
     await bus.events()
+
+
+async def make_errors(env, reg: str, n: int) -> None:
+    """n quadrature errors (illegal jumps) or n rejected pulses on A, shorter than FILTER_LEN 3."""
+    dut = env.dut
+    if reg == "QERR_COUNT":
+        await env.play(walk([2] * n, [6 * T_NS] * n, start_pos=env.pos), None)
+        return
+    for _ in range(n):
+        a = QUAD[env.pos % 4][0]
+        dut.a_in.value = 1 - a
+        await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")
+        dut.a_in.value = a
+        await Timer(8 * PERIOD_PS, unit="ps")
+    await env.settle()
+
+
+@cocotb_test()
+async def clear_and_command_strobes(dut):
+    """Byte enables of the writes that clear or command (the RDL): a write of QERR_COUNT or
+    GLITCH_COUNT with any one byte enable set, byte 3 alone included, clears it, one with none
+    (Wishbone SEL 0) leaves it; SNAP_CTRL.CMD and GSNAP_CTRL.CMD take a snapshot only when byte
+    0's enable is set (SNAP_READY, and SNAP_TIME moves, or neither)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=3)
+    masks = [1, 2, 4, 8, 3, 6, 12, 15] + ([0, 5, 9, 10] if bus.kind == "wb" else [])
+    for reg in ("QERR_COUNT", "GLITCH_COUNT"):
+        for strb in masks:
+            await make_errors(env, reg, 3)
+            before = await bus.rd(reg)
+            assert before >= 3, f"{reg}: {before} after 3 errors"
+            await bus.wr(reg, rng.getrandbits(32), strb)
+            await env.applied()
+            await env.settle()
+            after = await bus.rd(reg)
+            assert after == (before if strb == 0 else 0), \
+                f"{reg} written with byte enables {strb:#x}: {before} -> {after}"
+    for reg in ("SNAP_CTRL", "GSNAP_CTRL"):
+        for strb in masks:
+            await bus.events()
+            t0 = await bus.rd("SNAP_TIME")
+            await ClockCycles(dut.clk, 3)
+            await bus.wr(reg, regmap()[reg].fields["CMD"].mask | rng.getrandbits(32) & 0xFFFFFF00, strb)
+            await bus.wr(reg, 0)
+            await env.applied()
+            await env.settle()
+            snapped = "SNAP_READY" in await bus.events()
+            moved = await bus.rd("SNAP_TIME") != t0
+            assert snapped == moved == bool(strb & 1), \
+                f"{reg}.CMD written with byte enables {strb:#x}: SNAP_READY {snapped}, SNAP_TIME moved {moved}"
+
+
+@cocotb_test(skip=engine_build())
+async def count_clear_loses_no_error(dut):
+    """A per_channel build loses no error to a clear of QERR_COUNT or GLITCH_COUNT (the RDL):
+    the clearing write and an error timed so that the error reaches the counter from 3 clocks
+    before the clock the write takes effect to 3 after it (white box: the register block's write
+    strobe and the channel's error pulse, sampled every clock); the count after is 1 exactly
+    when the error came in that clock or later, 0 when before."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    regs, chan = dut.u_qei.u_regs, channel(dut)
+    seen = {}
+    for reg, pulse, flen in (("QERR_COUNT", chan.ev_qerr, 1), ("GLITCH_COUNT", chan.glitch_ab, 3)):
+        await env.setup(QeiModel(env.count_w), count=0, filter_len=flen)
+        # (the register block numbers a page's registers in the order of their offsets: its write
+        # strobe wr_c_q[k] is the k-th's)
+        bit = [r.name for r in sorted(regmap().values(), key=lambda r: r.offset)
+               if r.group == "chan"].index(reg)
+        got = set()
+        # the error's stimulus starts `lead` clocks after the write's; each trial aims the error
+        # at the next of 3 clocks before to 3 after the write's clock, from what the last trial
+        # measured (the AXI4-Lite master's random back-pressure moves the write), until it has
+        # come 1 clock before, in and 1 clock after it (at most 80 trials)
+        lead, aims = -10, (-3, -2, -1, 0, 1, 2, 3)
+        for n in range(80):
+            await bus.wr(reg, 0)
+            await env.settle()
+            at = {}
+
+            async def watch():
+                for k in range(80):
+                    await RisingEdge(dut.clk)
+                    await ReadOnly()
+                    if "w" not in at and int(regs.wr_c_q.value) >> bit & 1:
+                        at["w"] = k
+                    if "e" not in at and int(pulse.value):
+                        at["e"] = k
+
+            async def error():
+                await ClockCycles(dut.clk, lead + 20)
+                await make_errors(env, reg, 1)
+
+            w, e = cocotb.start_soon(watch()), cocotb.start_soon(error())
+            await ClockCycles(dut.clk, 20)
+            await bus.wr(reg, 0)
+            await e
+            await w
+            await env.settle()
+            value = await bus.rd(reg)
+            d = at["e"] - at["w"]
+            got.add(d)
+            assert value == int(d >= 0), \
+                f"{reg}: the error {d:+d} clocks from the clearing write's clock, the count {value}"
+            if n >= len(aims) and {-1, 0, 1} <= got:
+                break
+            lead = max(-20, min(20, lead + aims[(n + 1) % len(aims)] - d))
+        seen[reg] = sorted(got)
+        assert {-1, 0, 1} <= got, f"{reg}: the error came {sorted(got)} clocks from the write's"
+    dut._log.info("errors at these clocks from the clearing write's: %s", seen)
 
 
 @cocotb_test()
