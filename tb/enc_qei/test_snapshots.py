@@ -20,8 +20,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, signed
-from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, Timebase, begin, engine_build,
-                              engine_period, lacks, read_snapshot, run_feature)
+from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, Timebase, begin, build_param,
+                              engine_build, engine_period, lacks, read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import ClockWalk, Timeline, durations
 from enctools.regmap import event_bits, pack
@@ -537,13 +537,7 @@ async def snapshot_deltas_backward(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-def built_count_w() -> int:
-    """COUNT_W of the build being simulated (64 outside a simulation: pytest collecting)."""
-    top = getattr(cocotb, "top", None)
-    return int(top.COUNT_W.value) if top is not None else 64
-
-
-@cocotb_test(skip=built_count_w() <= 32)
+@cocotb_test(skip=build_param("COUNT_W", 64) <= 32)
 async def snapshot_count_across_bit_32(dut):
     """COUNT_W > 32: the count crosses bit 32 between two snapshots, up (a carry into the high
     word) and down (a borrow from it), and the top of the range (2^64 - 1 to 0 and back): each

@@ -18,8 +18,8 @@ from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import (ENGINE_IRQ, CONFIG_IDS, CONFIGS, Timebase, begin, engine_period, lacks,
-                              run_feature)
+from enctools.qei.env import (ENGINE_IRQ, CONFIG_IDS, CONFIGS, Timebase, begin, build_param,
+                              engine_period, lacks, run_feature)
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import durations, play_clocks, step_clocks
 from enctools.regmap import event_bits, field, pack, regmap
@@ -659,6 +659,52 @@ async def prescale_high_bits(dut):
     assert (t1 - t0) & ts_mask >= 100, \
         f"PRESCALE 0x3ff -> 0: TIMEBASE {t0:#x} -> {t1:#x} in 100 clocks and a read"
     await bus.wr("TB_PRESCALE", 0)
+
+
+@cocotb_test(skip=lacks("PERIOD") or build_param("TS_W", 16) != 16)
+async def timing_across_the_timebase_wrap(dut):
+    """TS_W 16: the timebase wraps from 0xFFFF to 0 (TIMEBASE read 0x200 clocks apart across the
+    wrap: the later value is the smaller, their difference modulo 2^16 the clocks between), and
+    the values timed across the wrap stay exact: PERIOD of an edge pair 0x100 clocks apart whose
+    first edge comes 0x80, 0x10 and 1 tick before the wrap; the stall of a STALL_TIMEOUT of 0x80
+    ticks that runs over the wrap (irq as stall_timeout_exact times it)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    clock = Timebase(dut)
+    await clock.phase(1 << 16, 0xFF00)
+    t0 = await bus.rd("TIMEBASE")
+    await ClockCycles(dut.clk, 0x200)
+    t1 = await bus.rd("TIMEBASE")
+    assert t1 < t0 and 0x200 <= (t1 - t0) & 0xFFFF <= 0x200 + 16, \
+        f"TIMEBASE {t0:#06x}, then {t1:#06x} 0x200 clocks and a read later"
+    d = 0x100
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=1))
+    await env.applied()
+    for before in (0x80, 0x10, 1):
+        await clock.phase(1 << 16, (-before - 8) & 0xFFFF)  # (the first edge: about 8 clocks on)
+        await env.play(walk([1, 1], [8 * T_NS, d * T_NS], start_pos=env.pos), None)
+        period = await bus.rd("PERIOD")
+        assert period == d, f"first edge {before:#x} ticks before the wrap: PERIOD {period:#x}, not {d:#x}"
+    await bus.wr("PERIOD_CTRL", 0)
+    t = 0x80
+    await bus.wr("IRQ_EN", event_bits("STALL"))
+    await bus.wr("STALL_TIMEOUT", t)
+    await env.applied()
+    await clock.phase(1 << 16, 0xFFD0)
+    await bus.events()
+    await env.settle(3)
+    assert dut.irq.value == 0
+    await step_forward(env)
+    n = 0
+    while dut.irq.value == 0:
+        await RisingEdge(dut.clk)
+        n += 1
+        assert n < t + 200 + env.lag, f"STALL_TIMEOUT {t:#x} over the wrap: no stall"
+    check_stall(env, t, 0, n)
+    await bus.wr("STALL_TIMEOUT", 0)
+    await bus.wr("IRQ_EN", 0)
+    await bus.events()
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

@@ -152,6 +152,13 @@ def engine_build() -> bool:
     return top is not None and int(top.ENGINE.value) != 0
 
 
+def build_param(name: str, default: int) -> int:
+    """The parameter ``name`` of the build being simulated (COUNT_W, TS_W, ...), for a test's skip
+    option; ``default`` outside a simulation (pytest collecting)."""
+    top = getattr(cocotb, "top", None)
+    return default if top is None else int(getattr(top, name).value)
+
+
 def lacks(*names: str) -> bool:
     """True when the build being simulated leaves out one of the units ``names`` (the RDL's
     feature names, enctools.regmap.units: RANGE = range modes, CEILING and compare; PROBE;
