@@ -19,8 +19,8 @@ from hedsmodel import QUAD, walk
 from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, begin, lacks, run_feature
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import (WIDE, ceilings, durations, near, play_clocks, slice_compare_cases,
-                                   step_clocks)
+from enctools.qei.stimulus import (FILTER, WIDE, ceilings, durations, near, play_clocks,
+                                   slice_compare_cases, step_clocks)
 from enctools.regmap import pack, regmap
 from enctools.tb import cocotb_test
 
@@ -75,6 +75,49 @@ async def index(dut):
         model.idx_hits = 0
     await bus.wr("INDEX_CTRL", 0)
     model.idx_action = "none"
+
+
+@cocotb_test()
+async def index_with_z_inverted(dut):
+    """CTRL.INV_Z = 1 with an active-low index at the pins (z_in idle high, low over the pulse):
+    the decoder's Z is the inverse, so INDEX_CTRL.EDGE rising is z_in falling. Preset on rising
+    with a gate, latch on falling, none: COUNT, EVENTS, INDEX_LATCH and ARM as the model's fed
+    the inverted Z, forward, back and dithering over the pulse."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    zf = lambda p: int(5 <= p % 40 <= 7)  # noqa: E731  (the decoder's Z; the pins carry 1 - zf)
+    dut.z_in.value = 1 - zf(env.pos)
+    for action, gate, edge in (("preset", QUAD[6 % 4], "rising"), ("latch", None, "falling"),
+                               ("none", None, "rising")):
+        await env.setup(model, func="x4", count=1000)
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=FILTER, INV_Z=1))
+        preset = rng.randint(100, 200)
+        await bus.set64("PRESET", preset)
+        model.preset = preset
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE=edge,
+                                        GATE_EN=int(gate is not None), GATE_A=gate[0] if gate else 0,
+                                        GATE_B=gate[1] if gate else 0, ARM=1))
+        model.idx_action, model.idx_oneshot, model.idx_edge = action, False, edge
+        model.idx_gate, model.idx_arm = gate, True
+        await env.applied()
+        for steps in ([1] * 90, [-1] * 90, [1, -1] * 6 + [1] * 8 + [-1, 1] * 6):
+            wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
+            pins = [(t, 1 - zf(p)) for (t, _, _), p in zip(wf.events, wf.positions)]
+            await env.drv.play(wf, index=pins)
+            for (_, a, b), p in zip(wf.events, wf.positions):
+                model.sample((a, b), zf(p))
+            env.pos = wf.positions[-1]
+            await env.settle()
+            what = f"INV_Z, {action} on {edge}" + (f" gated {gate}" if gate else "")
+            await env.check(model, what)
+            latch = await bus.get64("INDEX_LATCH")
+            assert latch == model.idx_latch, f"{what}: INDEX_LATCH {latch}, model {model.idx_latch}"
+        assert model.idx_hits >= 4, f"INV_Z, {action}: {model.idx_hits} qualified index pulses"
+        model.idx_hits = 0
+    await bus.wr("INDEX_CTRL", 0)
+    await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=FILTER))
+    dut.z_in.value = 0
 
 
 @cocotb_test()
