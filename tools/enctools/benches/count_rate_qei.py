@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The count-rate rule through the peripheral: enc_qei (FUNC x4) read over its bus.
+"""The count-rate rule through the peripheral: enc_qei read over its bus (FUNC x4; every function
+at the bound in every_function_at_bound).
 
 With CTRL.FILTER_LEN = F (set at run time, one build for every F), random walks whose states last
 uniform [S, 2S] clocks must count exactly at S = 1.05 x max(1, F/2) (the contract's bound, see
@@ -25,6 +26,7 @@ from cocotbext.quadrature import QuadratureDriver, SharedVector
 from hedsmodel.waveform import random_walk
 from enctools.qei.bus import PERIOD_PS, T_NS, QeiBus
 from enctools.qei.env import engine_lag
+from enctools.qei.model import EDGE_FUNCS, QUAD, QUAD_FUNCS, QeiModel
 from enctools.regmap import pack
 from enctools.tb import cocotb_test, reset_dut, start
 
@@ -42,12 +44,13 @@ class Qei:
         self.lag = engine_lag(self.channels) if int(dut.ENGINE.value) else 0
 
     async def walk(self, f: int, s_clocks: float, n: int, rng: random.Random,
-                   p_reverse: float = 0.3) -> list[dict]:
-        """Set FILTER_LEN = f, zero the counts, play n transitions on every channel at once (each
-        its own walk, channel 0's first from rng); return each channel's verdict."""
+                   p_reverse: float = 0.3, func: str = "x4") -> list[dict]:
+        """Set FILTER_LEN = f and CTRL.FUNC = func, zero the counts, play n transitions on every
+        channel at once (each its own walk, channel 0's first from rng); return each channel's
+        verdict (the count wanted: the walk's x4 steps, or QeiModel's count for another func)."""
         clk, views = self.dut.clk, [self.bus.at(k) for k in range(self.channels)]
         for bus in views:
-            await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", RANGE="free", FILTER_LEN=f))
+            await bus.wr("CTRL", pack("CTRL", EN=1, FUNC=func, RANGE="free", FILTER_LEN=f))
         await ClockCycles(clk, f + 6 + self.lag)
         for bus in views:
             await bus.set_count(0)
@@ -62,9 +65,16 @@ class Qei:
         for k, (bus, wf) in enumerate(zip(views, wfs)):
             count = await bus.count()
             events = await bus.events()
-            want = (wf.final_position - self.pos[k]) & self.mask
+            if func == "x4":
+                want = (wf.final_position - self.pos[k]) & self.mask
+            else:
+                model = QeiModel(self.mask.bit_length())
+                model.set_func(func, QUAD[self.pos[k] % 4])
+                for _, a, b in wf.events:
+                    model.sample((a, b))
+                want = model.count & self.mask
             self.pos[k] = wf.final_position
-            r = {"f": f, "s": s_clocks, "n": n, "channel": k, "count": count, "want": want,
+            r = {"func": func, "f": f, "s": s_clocks, "n": n, "channel": k, "count": count, "want": want,
                  "exact": count == want, "qerr": "QERR" in events, "glitch": "GLITCH" in events,
                  "min_state_clocks": wf.min_state_ns() / T_NS}
             r["flagged"] = r["qerr"] or r["glitch"]
@@ -98,6 +108,30 @@ async def exact_at_bound(dut):
             dut._log.info("F=%d S=%.3f: %s", f, r["s"], r)
             assert r["exact"], f"miscount through the bus at the contract's bound: {r}"
             assert not r["qerr"], f"QERR at the contract's bound: {r}"
+
+
+@cocotb_test()
+async def every_function_at_bound(dut):
+    """Every count function at its bound (x4: exact_at_bound), FILTER_LEN 1 and 4 at run time,
+    2,000 transitions each, COUNT = the function's count of the walk (QeiModel), no QERR. The
+    quadrature functions at S = 1.05 x max(1, F/2); x1_hyst at F = 1 only (after a reversal's
+    dither that the filter rejects, its hysteresis may keep a count one off its count of the
+    unfiltered inputs; FILTER_LEN's text). The A-edge functions (pulse_dir, increase, decrease)
+    count A's rising edges, so every A level is a pulse the filter must take: at S = 1.05 x
+    max(1, F) (every level of A at least 1.05 FILTER_LEN clocks) exact; at the quadrature bound
+    with reversals (A levels shorter than the filter) exact or GLITCH, never silent."""
+    qei, rng = await begin(dut)
+    for func in QUAD_FUNCS + EDGE_FUNCS:
+        for f in ((1,) if func == "x1_hyst" else (1, 4)):
+            bound = max(1.0, f) if func in EDGE_FUNCS else bound_clocks(f)
+            for r in await qei.walk(f, 1.05 * bound, 2000, rng, func=func):
+                dut._log.info("%s F=%d S=%.3f: %s", func, f, r["s"], r)
+                assert r["exact"], f"{func}: miscount through the bus at the contract's bound: {r}"
+                assert not r["qerr"], f"{func}: QERR at the contract's bound: {r}"
+            if func in EDGE_FUNCS and f > 1:
+                for r in await qei.walk(f, 1.05 * bound_clocks(f), 2000, rng, func=func):
+                    dut._log.info("%s F=%d S=%.3f: %s", func, f, r["s"], r)
+                    assert r["exact"] or r["glitch"], f"{func}: silent miscount with A pulses under FILTER_LEN: {r}"
 
 
 @cocotb_test()
