@@ -482,7 +482,7 @@ async def index_preset_at_wraps(dut):
     model = QeiModel(env.count_w)
     bus = env.bus
     for mode in ("free",) if env.lean else ("modulo", "limit", "non_recycle"):
-        for ceiling in (model.max,) if env.lean else (0x25, 0x0800_0040):
+        for ceiling in (model.max,) if env.lean else ceilings(env.count_w, zero=False)[:2]:
             await env.setup(model, rng_mode=mode, filter_len=1, count=0, ceiling=ceiling)
             await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
             model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"

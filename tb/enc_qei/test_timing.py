@@ -666,7 +666,7 @@ async def timing_across_the_timebase_wrap(dut):
     """TS_W 16: the timebase wraps from 0xFFFF to 0 (TIMEBASE read 0x200 clocks apart across the
     wrap: the later value is the smaller, their difference modulo 2^16 the clocks between), and
     the values timed across the wrap stay exact: PERIOD of an edge pair 0x100 clocks apart whose
-    first edge comes 0x80, 0x10 and 1 tick before the wrap; the stall of a STALL_TIMEOUT of 0x80
+    first edge comes 0x80, 0x10 and 1 tick before the wrap; the stall of a STALL_TIMEOUT of 128
     ticks that runs over the wrap (irq as stall_timeout_exact times it)."""
     env, rng = await begin(dut)
     bus = env.bus

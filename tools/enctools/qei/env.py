@@ -117,7 +117,9 @@ def engine_lag(channels: int) -> int:
 # the engine on Icarus too)
 CONFIGS = (("enc_qei_wb", 32, 32, "full", 0), ("enc_qei_axil", 64, 16, "full", 0),
            ("enc_qei_wb", 32, 32, "full", 1), ("enc_qei_axil", 64, 16, "full", 1),
-           ("enc_qei_wb", 32, 32, "lean", 1))
+           ("enc_qei_wb", 32, 32, "lean", 1),
+           # a count narrower than a register (COUNT_W 16): both architectures
+           ("enc_qei_wb", 16, 32, "full", 0), ("enc_qei_wb", 16, 32, "full", 1))
 
 
 def config_id(top: str, count_w: int, ts_w: int, profile: str = "full", engine: int = 0) -> str:

@@ -114,11 +114,11 @@ def slice_compare_cases(count_w: int) -> list:
 
 def ceilings(count_w, zero=True):
     """CEILINGs of 0, small ones, a high half that equals the count's with bit 27 set, bit 31
-    and bit 63."""
+    and bit 63, each cut to COUNT_W bits (a narrow build: 0x40 and 0x8021 at COUNT_W 16)."""
     c = ([0] if zero else []) + [0x25, 0x0800_0040, 0x8000_8021]
     if count_w > 32:
         c += [0x8000_0800_0000_0021]
-    return c
+    return list(dict.fromkeys(v & ((1 << count_w) - 1) for v in c))
 
 
 def near(values, lo, hi):
