@@ -155,20 +155,24 @@ async def beyond_rate_rule(dut):
 
 @cocotb_test()
 async def filter_len_clamp(dut):
-    """CTRL.FILTER_LEN 0 acts as 1 (states of 1.05 clocks count exactly), 31 as 16 (a level of
-    14.7 clocks is rejected, states of 17.5 .. 70 clocks count exactly)."""
+    """CTRL.FILTER_LEN 0 acts as 1: states of 1.05 clocks count exactly, and lone pulses of 1.3
+    clocks (one or two samples) are levels, not rejections (GLITCH_COUNT 0; as 2 it would reject
+    those of one sample). 17, 24 and 31 act as 16: lone pulses of 14.7 clocks (14 or 15 samples:
+    as 15 it would take those of 15) are rejected, each one GLITCH, and states of 17.5 .. 70
+    clocks count exactly."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
-    for f, lo, hi, pulses in ((0, 1.05, 2.0, 0), (31, 17.5, 70.0, 4)):
+    for f, lo, hi, width, guard in ((0, 1.05, 6.0, 1.3, 1.1), (17, 17.5, 70.0, 14.7, 17.05),
+                                    (24, 17.5, 70.0, 14.7, 17.05), (31, 17.5, 70.0, 14.7, 17.05)):
         await env.setup(model, func="x4", filter_len=f, count=0)
         wf = random_walk(rng, 40 if f else 300, lo * T_NS + 0.1, hi * T_NS, p_reverse=0.3,
                          start_pos=env.pos)
         n = len(wf.events)
-        if pulses:
-            wf = with_glitches(wf, rng, pulses, 14.7 * T_NS, guard_ns=17.05 * T_NS)
-            pulses = (len(wf.events) - n) // 2
-            assert pulses >= 2
+        wf = with_glitches(wf, rng, 6, width * T_NS, guard_ns=guard * T_NS)
+        inserted = (len(wf.events) - n) // 2
+        assert inserted >= 4, f"FILTER_LEN {f}: {inserted} pulses placed"
+        pulses = inserted if f else 0  # (FILTER_LEN 0 = 1: every pulse is taken)
         await env.drv.play(wf)
         last = QUAD[env.pos % 4]
         for (_, a, b), p in zip(wf.events[1:], wf.positions[1:]):

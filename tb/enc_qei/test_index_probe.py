@@ -508,7 +508,8 @@ async def z_and_probe_filter_lengths(dut):
     """Z and probe_in go through a filter of CTRL.FILTER_LEN samples like A and B: at FILTER_LEN
     4 .. 7 and 12 .. 15 (bit 2 set) and 8, a pulse of FILTER_LEN - 1 clocks is rejected (no INDEX,
     no PROBE event) and one of FILTER_LEN + 1 clocks is taken (INDEX on its rising edge, PROBE
-    with PROBE_CTRL on rising edges; a lean build: Z only)."""
+    with PROBE_CTRL on rising edges; a lean build: Z only). A level rejected on Z or probe_in is
+    no GLITCH (EVENTS.GLITCH and GLITCH_COUNT are A's and B's)."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -530,6 +531,8 @@ async def z_and_probe_filter_lengths(dut):
                 ev = await bus.events()
                 assert (event in ev) == taken, \
                     f"FILTER_LEN {f}: a {clocks}-clock pulse on {event}: events {sorted(ev)}"
+                assert "GLITCH" not in ev and await bus.rd("GLITCH_COUNT") == 0, \
+                    f"FILTER_LEN {f}: a {clocks}-clock pulse on {event} raised GLITCH"
     await bus.wr("PROBE_CTRL", 0)
 
 

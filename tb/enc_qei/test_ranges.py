@@ -207,6 +207,24 @@ async def non_recycle_stop_holds(dut):
             await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
             await env.check(model, f"stopped, then RANGE {other}")
             await stopped(f"stopped, then RANGE {other}", 1)
+            # an index preset loads PRESET but does not release it
+            await bus.set64("PRESET", 4)
+            model.preset = 4
+            await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+            model.idx_action, model.idx_oneshot, model.idx_edge = "preset", False, "rising"
+            model.idx_gate, model.idx_arm = None, True
+            await env.applied()
+            zf = lambda p, p0=env.pos: int(p == p0 + 1)  # noqa: E731  Z high over one state
+            steps = [1, 1, -1, -1]
+            await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model,
+                           zfun=zf)
+            assert model.idx_hits >= 1, "no index pulse reached the model"
+            model.idx_hits = 0
+            await bus.wr("INDEX_CTRL", 0)
+            model.idx_action = "none"
+            await env.check(model, f"stopped, RANGE {other}, an index preset")
+            await stopped(f"stopped, RANGE {other}, an index preset", 1)
+            assert await bus.count() == 4, f"stopped, RANGE {other}: the index preset did not load PRESET"
             await bus.set_count(5)
             model.write_count(5)
             await env.applied()

@@ -220,6 +220,24 @@ async def cmp_out_low_in_reset(dut):
 
 
 @cocotb_test()
+async def dir_change_after_reset(dut):
+    """EVENTS.DIR_CHANGE after reset (its text): the previous direction is up, so a first step
+    down raises DIR_CHANGE and a first step up does not; whichever way the steps before the
+    reset went."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    for before in (1, -1):
+        for first in (1, -1, -1, 1):
+            await env.play(walk([before] * 3, [30.0] * 3, start_pos=env.pos), None)
+            await pulse_rst(dut, 2)
+            await env.settle(20)
+            await env.play(walk([first], [30.0], start_pos=env.pos), None)
+            ev = await bus.events()
+            assert ("DIR_CHANGE" in ev) == (first < 0), \
+                f"steps {before:+d} before the reset, a first step {first:+d} after it: EVENTS {sorted(ev)}"
+
+
+@cocotb_test()
 async def status_after_reset(dut):
     """STATUS right after a reset: DIR (the direction of the last step) reads 1 (up) however
     the steps before the reset went, from the first read on; VALID (the filter settled, FILTER_LEN

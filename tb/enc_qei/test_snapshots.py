@@ -233,6 +233,60 @@ async def unit_timer_period(dut):
     await bus.wr("TB_PRESCALE", 0)
 
 
+@cocotb_test(skip=lacks("PERIOD"))
+async def unit_timer_rewrites(dut):
+    """The channel's unit timer keeps its grid through rewrites (SNAP_CTRL.PERIOD_EN, SNAP_PERIOD):
+    SNAP_PERIOD 400 ticks (PRESCALE 0), PERIOD_EN 0 -> 1, then SNAP_CTRL rewritten with PERIOD_EN
+    1, EDGE changed and IN_EN set, a snap_in pulse, SNAP_CTRL rewritten with PERIOD_EN 1 and CMD,
+    then SNAP_PERIOD 150 in the middle of a period: the periodic SNAP_TIMEs (SNAP_TIME polled
+    every 20 clocks) stay 400 apart on one grid through the rewrites, snap_in's and CMD's
+    snapshots are their own, off the grid, the period in progress at the SNAP_PERIOD write keeps
+    its 400, and the next ones come 150 apart."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0)
+    clock = Timebase(dut)
+    await bus.wr("SNAP_PERIOD", 400)
+    await env.applied()
+    t0 = clock.now()
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1))
+    # (one coroutine on the bus: the writes at their times between the polls)
+    acts = [(1000, "SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1, EDGE="a_rising", IN_EN=1)),
+            (1400, "snap_in", 1), (1410, "snap_in", 0),
+            (2200, "SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1, CMD=1)),
+            (3100, "SNAP_PERIOD", 150)]
+    at, seen, last = {}, [], None
+    while clock.now() - t0 < 4300:
+        if acts and clock.now() - t0 >= acts[0][0]:
+            _, reg, value = acts.pop(0)
+            at[reg, value] = clock.now() - t0
+            if reg == "snap_in":
+                dut.snap_in.value = value
+            else:
+                await bus.wr(reg, value)
+        t = await bus.rd("SNAP_TIME")
+        if t != last:
+            seen.append((t - t0) & ((1 << int(dut.TS_W.value)) - 1))
+            last = t
+        await ClockCycles(dut.clk, 20)
+    await bus.wr("SNAP_CTRL", 0)
+    dut._log.info("SNAP_TIMEs from the PERIOD_EN write: %s", seen)
+    seen = [t for t in seen if 0 < t <= 4300]  # (the one before the timer: SNAP_TIME as it was)
+    g = seen[0]
+    in_at, cmd_at = at["snap_in", 1], at["SNAP_CTRL", pack("SNAP_CTRL", PERIOD_EN=1, CMD=1)]
+    new_at = at["SNAP_PERIOD", 150]
+    off = [t for t in seen if t < new_at and (t - g) % 400]
+    assert len(off) == 2 and in_at <= off[0] <= in_at + 40 + env.lag and \
+        cmd_at <= off[1] <= cmd_at + 40 + env.lag, \
+        f"SNAP_TIMEs off the 400-tick grid from {g}: {off} (snap_in at {in_at}, CMD at {cmd_at})"
+    grid = [t for t in seen if t not in off]
+    first_new = min(t for t in grid if t > new_at)
+    want = list(range(g, first_new, 400)) + list(range(first_new, grid[-1] + 1, 150))
+    assert grid == want, f"periodic SNAP_TIMEs {grid}, expected {want}"
+    assert (first_new - g) % 400 == 0 and grid[-1] > first_new, \
+        f"the period in progress at SNAP_PERIOD 150 (written at {new_at}) ended at {first_new}"
+
+
 @cocotb_test(skip=lacks("PERIOD") or not engine_build())
 async def unit_timer_faster_than_the_engine(dut):
     """The shared engine: SNAP_PERIOD below P (0, 1, 5, P / 2, P - 1) with PERIOD_EN, a request at
@@ -565,6 +619,38 @@ async def snapshot_count_across_bit_32(dut):
                 f"{signed(snap['edge_delta'])}, model {model.delta}"
             assert await bus.count() == model.count, f"{what}: COUNT, model {model.count:#x}"
             model.delta = 0
+    await bus.wr("SNAP_CTRL", 0)
+
+
+@cocotb_test()
+async def snapshot_deltas_skip_en_off(dut):
+    """Steps while CTRL.EN = 0 are not counted in SNAP_DELTA or SNAP_EDGE_DELTA (their text):
+    a snapshot, steps with EN 0, steps with EN 1, a snapshot: both deltas are the EN 1 steps;
+    COUNT moved by them only."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=0x1000, filter_len=1, en=0)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+    await env.settle(4)
+    for off, on in ((rng.randint(5, 15), rng.randint(3, 9)), (rng.randint(5, 15), -rng.randint(3, 9))):
+        await bus.wr("CTRL", pack("CTRL", EN=0, FUNC="x4", FILTER_LEN=1))
+        await env.applied()
+        await env.play(walk([1] * off, durations(rng, off, f=1), start_pos=env.pos), None)
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC="x4", FILTER_LEN=1))
+        model.set_func("x4", QUAD[env.pos % 4])
+        model.en = True
+        await env.applied()
+        model.delta = 0
+        steps = [1 if on > 0 else -1] * abs(on)
+        await env.play(walk(steps, durations(rng, abs(on), f=1), start_pos=env.pos), model)
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1, EDGE="any"))
+        await env.settle(4)
+        snap = await read_snapshot(bus)
+        assert signed(snap["delta"]) == on == signed(snap["edge_delta"]), \
+            f"{off} steps with EN 0, then {on:+d} with EN 1: SNAP_DELTA {signed(snap['delta'])}, " \
+            f"SNAP_EDGE_DELTA {signed(snap['edge_delta'])}"
+        assert await bus.count() == model.count, f"{off} steps with EN 0: COUNT moved"
     await bus.wr("SNAP_CTRL", 0)
 
 

@@ -287,6 +287,65 @@ async def stall_timeout_zero_is_off(dut):
 
 
 @cocotb_test(skip=lacks("PERIOD"))
+async def stall_ends_on_function_steps(dut):
+    """What restarts the stall timeout is a step of the count function while CTRL.EN = 1, whether
+    the range applies it or not (STALL_TIMEOUT's text). STALL_TIMEOUT 600 ticks (PRESCALE 0),
+    motion every 200 clocks for 1,600: limit at CEILING pushed up (every step blocked), no
+    STALL; x4 with B dithering, no STALL; x1a with the same dither (steps x1a does not count),
+    STALL; EN = 0 with the shaft turning, STALL."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    t = 600
+    for what, mode, func, en, want in (("limit at CEILING, pushed up", "limit", "x4", 1, False),
+                                       ("x4, B dithering", "free", "x4", 1, False),
+                                       ("x1a, B dithering", "free", "x1a", 1, True),
+                                       ("EN 0, turning", "free", "x4", 0, True)):
+        if mode == "limit" and env.lean:
+            continue
+        await env.setup(model, rng_mode=mode, func=func, en=en, count=0x40, ceiling=0x40)
+        while env.pos % 4 != 1:  # (at state 1 -> 2 and back B alone changes)
+            await env.play(walk([1], [30.0], start_pos=env.pos), None)
+        await bus.wr("STALL_TIMEOUT", t)
+        await env.applied()
+        await bus.events()
+        steps = [1] * 8 if mode == "limit" or not en else [1, -1] * 4
+        await env.play(walk(steps, [200 * T_NS] * len(steps), start_pos=env.pos), None)
+        stall = "STALL" in await bus.events()
+        await bus.wr("STALL_TIMEOUT", 0)
+        await env.applied()
+        assert stall == want, f"{what}: STALL {'raised' if stall else 'not raised'} with a step " \
+                              f"every 200 clocks and STALL_TIMEOUT {t}"
+
+
+@cocotb_test(skip=lacks("PERIOD"))
+async def period_n_zero_and_overflow_cleared(dut):
+    """PERIOD_CTRL.N 0 acts as 1: PERIOD over one edge interval. PERIOD_CTRL.OVERFLOW describes
+    the value in PERIOD: after an overflowed measurement (TS_W 16: 65,536 ticks) the next clean
+    one clears it (TS_W 32 builds: N only)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    ovf = regmap()["PERIOD_CTRL"].fields["OVERFLOW"].mask
+    d = 23
+    await bus.wr("PERIOD_CTRL", pack("PERIOD_CTRL", EN=1, EDGE="any", N=0))
+    await env.applied()
+    await env.play(walk([1] * 6, [d * T_NS] * 6, start_pos=env.pos), None)
+    period = await bus.rd("PERIOD")
+    assert period == d, f"N 0: PERIOD {period}, one edge interval is {d}"
+    if int(dut.TS_W.value) == 16:
+        await env.settle(65540)
+        await env.play(walk([1], [d * T_NS], start_pos=env.pos), None)
+        assert await bus.rd("PERIOD_CTRL") & ovf, "no OVERFLOW after 65,540 ticks without an edge"
+        await env.play(walk([1] * 3, [d * T_NS] * 3, start_pos=env.pos), None)
+        ctrl, period = await bus.rd("PERIOD_CTRL"), await bus.rd("PERIOD")
+        assert not ctrl & ovf and period == d, \
+            f"a clean measurement after an overflow: OVERFLOW {int(bool(ctrl & ovf))}, PERIOD {period}"
+    await bus.wr("PERIOD_CTRL", 0)
+    await bus.events()
+
+
+@cocotb_test(skip=lacks("PERIOD"))
 async def period_large_n(dut):
     """PERIOD_CTRL.N up to 255: PERIOD = N x the edge interval (any edge, states of 3 clocks)."""
     env, rng = await begin(dut)
