@@ -14,13 +14,13 @@ import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
-from hedsmodel import QUAD, walk
+from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
 from enctools.qei.env import (CONFIG_IDS, CONFIGS, begin, caps_of, channel, engine_build, engine_lag,
-                              run_feature)
+                              lacks, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations
+from enctools.qei.stimulus import durations, illegal_jumps, rejected_pulses
 from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
 from enctools.tb import cocotb_test
 
@@ -256,18 +256,11 @@ async def register_patterns(dut):
 
 
 async def make_errors(env, reg: str, n: int) -> None:
-    """n quadrature errors (illegal jumps) or n rejected pulses on A, shorter than FILTER_LEN 3."""
-    dut = env.dut
+    """n quadrature errors (illegal jumps) or n rejected pulses on A (FILTER_LEN 3)."""
     if reg == "QERR_COUNT":
-        await env.play(walk([2] * n, [6 * T_NS] * n, start_pos=env.pos), None)
-        return
-    for _ in range(n):
-        a = QUAD[env.pos % 4][0]
-        dut.a_in.value = 1 - a
-        await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")
-        dut.a_in.value = a
-        await Timer(8 * PERIOD_PS, unit="ps")
-    await env.settle()
+        await illegal_jumps(env, n)
+    else:
+        await rejected_pulses(env, n)
 
 
 @cocotb_test()
@@ -291,7 +284,7 @@ async def clear_and_command_strobes(dut):
             after = await bus.rd(reg)
             assert after == (before if strb == 0 else 0), \
                 f"{reg} written with byte enables {strb:#x}: {before} -> {after}"
-    for reg in ("SNAP_CTRL", "GSNAP_CTRL"):
+    for reg in () if lacks("TIMING") else ("SNAP_CTRL", "GSNAP_CTRL"):
         for strb in masks:
             await bus.events()
             t0 = await bus.rd("SNAP_TIME")

@@ -151,6 +151,8 @@ async def events_and_irq(dut):
              "SNAP_READY", "PERIOD_READY", "STALL"]
     if env.lean:  # (no compare, probe, period or stall unit)
         names = [n for n in names if n not in ("CMP", "PROBE", "PERIOD_READY", "STALL")]
+    if lacks("TIMING"):  # (the counting profile: no snapshots, period or stall)
+        names = [n for n in names if n not in ("SNAP_READY", "PERIOD_READY", "STALL")]
     for name in names:
         await bus.wr("IRQ_EN", 0)
         await bus.events()

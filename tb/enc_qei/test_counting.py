@@ -14,10 +14,11 @@ import pytest
 from cocotb.triggers import Timer
 from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
 
-from enctools.qei.bus import PERIOD_PS, T_NS
+from enctools.qei.bus import T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
 from enctools.qei.model import FUNCS, QeiModel
-from enctools.qei.stimulus import BURST, ceilings, durations, near, steps_from, walk_with_jumps
+from enctools.qei.stimulus import (BURST, ceilings, durations, illegal_jumps, near, rejected_pulses,
+                                   steps_from, walk_with_jumps)
 from enctools.regmap import get_field, pack, regmap, units
 from enctools.tb import cocotb_test
 
@@ -300,14 +301,8 @@ async def en_off_keeps_the_rest(dut):
     await env.setup(model, count=count, en=0, filter_len=3,
                     compare=None if "RANGE" not in have else count + 7)
     n_q, n_g = rng.randint(3, 9), rng.randint(3, 9)
-    await env.play(walk([2] * n_q, [6 * T_NS] * n_q, start_pos=env.pos), None)
-    for _ in range(n_g):  # lone pulses of 1.5 clocks on A: shorter than FILTER_LEN 3
-        a = QUAD[env.pos % 4][0]
-        dut.a_in.value = 1 - a
-        await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")
-        dut.a_in.value = a
-        await Timer(8 * T_NS, unit="ns")
-    await env.settle()
+    await illegal_jumps(env, n_q)
+    await rejected_pulses(env, n_g)
     q, g = await bus.rd("QERR_COUNT"), await bus.rd("GLITCH_COUNT")
     assert q == n_q, f"EN 0: QERR_COUNT {q} after {n_q} illegal jumps"
     assert g == n_g, f"EN 0: GLITCH_COUNT {g} after {n_g} rejected pulses"
@@ -317,7 +312,8 @@ async def en_off_keeps_the_rest(dut):
     t0 = await bus.rd("TIMEBASE")
     await Timer(50 * T_NS, unit="ns")
     t1 = await bus.rd("TIMEBASE")
-    assert (t1 - t0) & ts_mask >= 50, f"EN 0: TIMEBASE {t0:#x} -> {t1:#x} in 50 clocks"
+    assert (t1 - t0) & ts_mask >= 50 or "TIMING" not in have, \
+        f"EN 0: TIMEBASE {t0:#x} -> {t1:#x} in 50 clocks"
     if "PROBE" in have:
         await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1))
         await env.applied()
@@ -329,7 +325,8 @@ async def en_off_keeps_the_rest(dut):
         latch = await bus.get64("PROBE_LATCH")
         t_probe = await bus.rd("PROBE_TIME")
         assert latch == count, f"EN 0: PROBE_LATCH {latch:#x}, count {count:#x}"
-        assert 0 < (t_probe - before) & ts_mask < (after - before) & ts_mask, \
+        assert 0 < (t_probe - before) & ts_mask < (after - before) & ts_mask or \
+            "TIMING" not in have, \
             f"EN 0: PROBE_TIME {t_probe:#x} not between TIMEBASE {before:#x} and {after:#x}"
         assert "PROBE" in await bus.events(), "EN 0: a probe edge raised no PROBE"
     if "RANGE" in have:

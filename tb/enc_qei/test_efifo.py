@@ -22,13 +22,13 @@ from __future__ import annotations
 
 import cocotb
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 import numpy as np
 from hedsmodel import QUAD, EncoderUnit, Profile, walk
 from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import build_name, channel_envs, begin
+from enctools.qei.env import begin, build_name, channel, channel_envs, engine_build
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import pulse_rst
 from enctools.regmap import enum, event_bits, get_field, pack
@@ -530,6 +530,67 @@ async def index_marks_its_entry(dut):
     assert [e["IDX"] for e in entries] == expect, \
         f"IDX {[e['IDX'] for e in entries]}, index rising at {expect}"
     dut._log.info("%d entries, %d with IDX", len(entries), sum(expect))
+
+
+@cocotb_test(skip=engine_build())
+async def full_fifo_pop_in_the_push_clock(dut):
+    """A full FIFO and a step against an EFIFO_ENTRY read (white box, per-channel build: the
+    FIFO's push and pop clocks sampled every clock): the step's entry is written in the clock
+    after the step (its timestamp clock); it is stored when the read pops in that clock or before
+    and dropped (EFIFO_LOST 1) only when the pop comes later (EFIFO_CTRL's text). The read's LEFT
+    never counts an entry written in its own clock (depth - 1 every time)."""
+    envs, rng = await _start(dut)
+    env = envs[0]
+    bus = env.bus
+    depth = 1 << int(dut.EFIFO_LOG2.value)
+    efifo = channel(dut).g_efifo.u_efifo
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1))
+    await env.applied()
+    got = set()
+    lead, aims = -4, (-3, -2, -1, 0, 1, 2, 3)
+    for n in range(80):
+        while await bus.rd("EFIFO_STATUS") & 0x1FF < depth:  # full again
+            await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+        await bus.wr("EFIFO_LOST", 0)
+        await env.settle()
+        at = {}
+
+        async def watch():
+            for k in range(60):
+                await RisingEdge(dut.clk)
+                await ReadOnly()
+                if "push" not in at and int(efifo.push_q.value):
+                    at["push"] = k
+                if "pop" not in at and int(efifo.pop.value):
+                    at["pop"] = k
+
+        async def step():
+            await ClockCycles(dut.clk, lead + 20)
+            await FallingEdge(dut.clk)
+            env.pos += 1
+            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+
+        w, s_ = cocotb.start_soon(watch()), cocotb.start_soon(step())
+        await ClockCycles(dut.clk, 20)
+        word = await bus.rd("EFIFO_ENTRY")
+        await s_
+        await w
+        await env.settle()
+        lost = await bus.rd("EFIFO_LOST")
+        d = at["push"] - at["pop"]
+        got.add(d)
+        e = entry_fields(word)
+        assert e["VALID"] and e["LEFT"] == depth - 1, \
+            f"the step's entry {d:+d} clocks from the pop: the read answered {e} (LEFT {depth - 1})"
+        assert lost == int(d < 0), \
+            f"a full FIFO, the step's entry written {d:+d} clocks from the pop: EFIFO_LOST {lost}"
+        if n >= len(aims) and {-1, 0, 1} <= got:
+            break
+        lead = max(-20, min(20, lead + aims[(n + 1) % len(aims)] - d))
+    assert {-1, 0, 1} <= got, f"the step's entry came {sorted(got)} clocks from the pop"
+    dut._log.info("pushes at these clocks from the pop: %s", sorted(got))
+    await bus.wr("EFIFO_CTRL", 0)
 
 
 @cocotb_test()

@@ -33,7 +33,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from enctools.qei.env import ENGINE_ACT, CONFIG_IDS, CONFIGS, begin, engine_period, run_feature
+from enctools.qei.env import ENGINE_ACT, CONFIG_IDS, CONFIGS, begin, engine_period, lacks, run_feature
 from enctools.regmap import pack
 from enctools.tb import cocotb_test
 
@@ -118,7 +118,7 @@ def check_deferred(requests, taken, p, what) -> None:
     assert used == set(taken), f"{what}: snapshots without a request: {sorted(set(taken) - used)}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def cmd_snapshot_clock(dut):
     """GSNAP_CTRL.CMD and a channel's SNAP_CTRL.CMD, twelve writes each at random distances:
     the snapshot clock (where GSNAP_TIME / SNAP_TIME take the timebase) is the write clock +
@@ -149,7 +149,7 @@ async def cmd_snapshot_clock(dut):
         assert seen == {(lat, RESP[trace.wb])}, f"{reg}.CMD: {seen}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def period_en_rewrite_and_restart(dut):
     """The unit timer at GSNAP_PERIOD P: PERIOD_EN written 1 again (and CMD with it) at random
     phases keeps every timer snapshot on the grid of the first one, P clocks apart; PERIOD_EN
@@ -207,7 +207,7 @@ async def period_en_rewrite_and_restart(dut):
         await bus.wr("GSNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def new_period_after_the_one_in_progress(dut):
     """GSNAP_PERIOD changed (P1 <-> P2) while the timer runs, the write's snapshot clock d clocks
     before the end of the period in progress (aimed at d = -2 .. 11 and four random d): the timer

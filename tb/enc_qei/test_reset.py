@@ -171,7 +171,10 @@ async def irq_low_in_reset(dut):
     env, rng = await begin(dut)
     bus = env.bus
     await bus.wr("IRQ_EN", 0xFFF)
-    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))  # SNAP_READY pending
+    if lacks("TIMING"):  # (the counting profile: an illegal jump, QERR pending)
+        await env.play(walk([2], [45.0], start_pos=env.pos), None)
+    else:
+        await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))  # SNAP_READY pending
     await env.settle(20)
     assert dut.irq.value == 1
     await FallingEdge(dut.clk)
@@ -244,7 +247,8 @@ async def status_after_reset(dut):
     + 2 clocks after rst) reads 0 in a read requested in the clock rst falls, then 1, never back
     to 0: for each d, one reset after a step down and one read requested d clocks after it, d = 0
     .. 12 on a per_channel build (1 from FILTER_LEN + 2 = 5), d = 0 .. P + 56 on the shared
-    engine (1 from P + 44 + 5: CAPS.ENGINE shared (1))."""
+    engine (1 from P + 44 + 5: CAPS.ENGINE shared (1)). On AXI4-Lite, whose master's random
+    back-pressure moves the clock a read samples, only the 1 from there on is checked."""
     env, rng = await begin(dut)
     bus = env.bus
     settled = FILTER_RESET + 2 + (engine_period(int(dut.CHANNELS.value)) + ENGINE_SHOW
@@ -262,8 +266,9 @@ async def status_after_reset(dut):
         valid.append(int(bool(status & field("STATUS", "VALID").mask)))
         await env.settle(20)
     dut._log.info("STATUS.VALID in reads d = 0, 1, ... clocks after rst: %s", "".join(map(str, valid)))
-    assert valid[0] == 0, "STATUS.VALID 1 in a read requested in the clock rst fell"
-    assert valid == sorted(valid), f"STATUS.VALID went back to 0 (reads d = 0, 1, ...: {valid})"
+    if bus.kind == "wb":  # (AXI4-Lite: random back-pressure moves the clock a read samples)
+        assert valid[0] == 0, "STATUS.VALID 1 in a read requested in the clock rst fell"
+        assert valid == sorted(valid), f"STATUS.VALID went back to 0 (reads d = 0, 1, ...: {valid})"
     assert all(valid[settled:]), f"STATUS.VALID 0 in a read {valid.index(0, settled)} clocks after rst"
 
 

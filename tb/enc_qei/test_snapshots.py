@@ -93,7 +93,7 @@ async def snapshot_coherence(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_values_exact(dut):
     """Snapshots by SNAP_CTRL.CMD, by snap_in (SNAP_CTRL.IN_EN) and by GSNAP_CTRL.CMD while the
     shaft moves clock by clock (FILTER_LEN 1, states of 1 to 6 clocks, reversals): each one's
@@ -158,7 +158,7 @@ async def snapshot_values_exact(dut):
     dut._log.info("snapshots checked: %s", seen)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_deltas_across_wraps(dut):
     """SNAP_DELTA counts the motion (every step of the function) across modulo wraps and limit
     stops; SNAP_EDGE_DELTA is the position change between the last selected edges (any edge, and
@@ -334,7 +334,7 @@ async def unit_timer_faster_than_the_engine(dut):
         await env.applied()
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_wide_values(dut):
     """SNAP_COUNT of counts with every bit pattern (the high half too): a snapshot holds them;
     SNAP_TIME and SNAP_EDGE_TIME of an edge taken 4,200 to 12,600 clocks after reset (timebase
@@ -414,7 +414,7 @@ async def unit_timer_prescaled(dut):
     await bus.events()
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_delta_across_presets(dut):
     """A preset on every index (a rotary axis referenced every turn) at the count-rate bound:
     SNAP_DELTA and SNAP_EDGE_DELTA count the motion, the steps the shaft moved, including the
@@ -458,7 +458,7 @@ async def snapshot_delta_across_presets(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_deltas_held(dut):
     """SNAP_DELTA and SNAP_EDGE_DELTA hold their values between snapshots: each read three times,
     an odd and an even number of clocks apart, after walks forward, back and turning between two
@@ -498,7 +498,7 @@ async def snapshot_deltas_held(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_edge_time_long_after_the_edge(dut):
     """Five steps, a snapshot, then snapshots 1,061, 2,122 and 5,305 clocks later with the shaft
     at rest (EDGE any, PRESCALE 0): SNAP_EDGE_TIME stays the last step's time, SNAP_DELTA and
@@ -531,7 +531,7 @@ async def snapshot_edge_time_long_after_the_edge(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_edge_delta_after_reversal(dut):
     """SNAP_CTRL.EDGE = A rising: a snapshot taken after steps back behind the last rising edge of
     A (steps counted since that edge go down from a positive value), then walks forward through
@@ -561,7 +561,7 @@ async def snapshot_edge_delta_after_reversal(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_deltas_backward(dut):
     """SNAP_DELTA and SNAP_EDGE_DELTA when the motion since reset is negative: the shaft first
     turns backward from reset, so the motion a snapshot keeps (the base of the next delta) has
@@ -591,7 +591,7 @@ async def snapshot_deltas_backward(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test(skip=build_param("COUNT_W", 64) <= 32)
+@cocotb_test(skip=lacks("TIMING") or build_param("COUNT_W", 64) <= 32)
 async def snapshot_count_across_bit_32(dut):
     """COUNT_W > 32: the count crosses bit 32 between two snapshots, up (a carry into the high
     word) and down (a borrow from it), and the top of the range (2^64 - 1 to 0 and back): each
@@ -622,7 +622,7 @@ async def snapshot_count_across_bit_32(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def snapshot_deltas_skip_en_off(dut):
     """Steps while CTRL.EN = 0 are not counted in SNAP_DELTA or SNAP_EDGE_DELTA (their text):
     a snapshot, steps with EN 0, steps with EN 1, a snapshot: both deltas are the EN 1 steps;
@@ -654,7 +654,7 @@ async def snapshot_deltas_skip_en_off(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def edge_time_across_count_writes(dut):
     """A COUNT_LO write leaves the filters' FILTER_LEN alone in every clock: FILTER_LEN 3, then
     COUNT_LO writes, each with one step whose pins change i clocks after the write starts. With
@@ -701,7 +701,7 @@ async def edge_time_across_count_writes(dut):
     await bus.wr("SNAP_CTRL", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def global_snapshot_one_channel(dut):
     """The global snapshot of a one-channel build: by GSNAP_CTRL.CMD (ten of them, at timebase
     values 173 clocks and a bus transfer apart), by a rising snap_in with GSNAP_CTRL.IN_EN (none
@@ -772,7 +772,7 @@ async def global_snapshot_one_channel(dut):
             f"GSNAP_TIMEs {[hex(t) for t in times]}: gaps {gaps}, GSNAP_PERIOD {period:#x}"
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def unit_timer_high_bits(dut):
     """SNAP_PERIOD and GSNAP_PERIOD (a lean build: GSNAP_PERIOD) with a high bit set (each of bits 10 .. TS_W - 1, with 3 ticks
     more): no snapshot within 600 clocks of setting PERIOD_EN (a period bit lost on its way to a

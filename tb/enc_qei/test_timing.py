@@ -26,7 +26,7 @@ from enctools.regmap import event_bits, field, pack, regmap
 from enctools.tb import cocotb_test
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def prescaler_and_snap_in(dut):
     """TIMEBASE advances once every PRESCALE + 1 clocks: snap_in rising edges G clocks apart give
     SNAP_TIME values G / (PRESCALE + 1) apart (floor or ceiling); snap_in held high snaps once."""
@@ -384,6 +384,15 @@ async def clocks_to_stall(env, t: int, pre: int) -> int:
     await Timer((t * (pre + 1) + 40) * PERIOD_PS, unit="ps")  # any stall of the wait is over
     await RisingEdge(dut.clk)
     await bus.events()
+    n = await step_to_irq(env, t * (pre + 1) + 200 + env.lag, f"STALL_TIMEOUT {t} PRESCALE {pre}")
+    await bus.events()
+    return n
+
+
+async def step_to_irq(env, limit: int, what: str) -> int:
+    """irq low (events cleared, IRQ_EN = STALL): a step, and the clocks from it to irq (at most
+    ``limit``)."""
+    dut = env.dut
     await env.settle(3)
     assert dut.irq.value == 0
     await step_forward(env)
@@ -391,8 +400,7 @@ async def clocks_to_stall(env, t: int, pre: int) -> int:
     while dut.irq.value == 0:
         await RisingEdge(dut.clk)
         n += 1
-        assert n < t * (pre + 1) + 200 + env.lag, f"STALL_TIMEOUT {t} PRESCALE {pre}: no stall"
-    await bus.events()
+        assert n < limit, f"{what}: no stall"
     return n
 
 
@@ -506,7 +514,7 @@ async def stall_ended_by_a_step(dut):
     await bus.wr("STALL_TIMEOUT", 0)
 
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def prescaler_long(dut):
     """TIMEBASE at PRESCALE values that set bits 0 .. 8, over 8 to 150 ticks (2,400 clocks or
     more): snap_in rising edges G clocks apart give SNAP_TIME values G / (PRESCALE + 1) apart
@@ -689,7 +697,7 @@ async def period_held_until_next_capture(dut):
     period = await bus.rd("PERIOD")
     assert period == e, f"PERIOD {period:#x} after the end edge, expected {e:#x}"
 
-@cocotb_test()
+@cocotb_test(skip=lacks("TIMING"))
 async def prescale_high_bits(dut):
     """TB_PRESCALE with a high bit set (0x8003, 0x4005, 0x2007, 0x1009: more than 4,000 clocks per
     tick): TIMEBASE advances at most once over 400 clocks. And a new PRESCALE restarts the
@@ -752,18 +760,51 @@ async def timing_across_the_timebase_wrap(dut):
     await env.applied()
     await clock.phase(1 << 16, 0xFFD0)
     await bus.events()
-    await env.settle(3)
-    assert dut.irq.value == 0
-    await step_forward(env)
-    n = 0
-    while dut.irq.value == 0:
-        await RisingEdge(dut.clk)
-        n += 1
-        assert n < t + 200 + env.lag, f"STALL_TIMEOUT {t:#x} over the wrap: no stall"
+    n = await step_to_irq(env, t + 200 + env.lag, f"STALL_TIMEOUT {t:#x} over the wrap")
     check_stall(env, t, 0, n)
     await bus.wr("STALL_TIMEOUT", 0)
     await bus.wr("IRQ_EN", 0)
     await bus.events()
+
+
+@cocotb_test(skip=not lacks("TIMING"))
+async def timing_unit_left_out(dut):
+    """CAPS.TIMING 0 (the counting profile): TIMEBASE .. STALL_TIMEOUT read 0 and ignore writes,
+    PROBE_TIME reads 0, STATUS.STALLED stays 0 and STALL, SNAP_READY, PERIOD_READY and
+    PERIOD_OVF never fire (CAPS.TIMING's text), with every one of those registers written all
+    ones, GSNAP_CTRL's timer and snap_in on, the shaft turning and a probe edge."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    await env.setup(QeiModel(env.count_w), count=0)
+    rm = regmap()
+    span = [n for n, r in sorted(rm.items(), key=lambda x: x[1].offset)
+            if rm["TIMEBASE"].offset <= r.offset <= rm["STALL_TIMEOUT"].offset]
+    for name in span + ["GSNAP_PERIOD"]:
+        await bus.wr(name, 0xFFFFFFFF)
+    await bus.wr("GSNAP_CTRL", pack("GSNAP_CTRL", CMD=1, IN_EN=1, PERIOD_EN=1))
+    await bus.wr("PROBE_CTRL", pack("PROBE_CTRL", EN=1))
+    await env.applied()
+    await bus.events()
+    for _ in range(3):
+        dut.snap_in.value = 1
+        await ClockCycles(dut.clk, 5)
+        dut.snap_in.value = 0
+        await env.play(walk([1] * 5 + [-1] * 3, durations(rng, 8), start_pos=env.pos), None)
+    dut.probe_in.value = 1
+    await ClockCycles(dut.clk, 10)
+    dut.probe_in.value = 0
+    await ClockCycles(dut.clk, 400)
+    await env.settle()
+    for name in span + ["PROBE_TIME"]:
+        got = await bus.rd(name)
+        assert got == 0, f"no timing unit: {name} reads {got:#x}"
+    assert not await stalled(bus), "no timing unit: STATUS.STALLED"
+    ev = await bus.events()
+    assert "PROBE" in ev, "no PROBE event (the probe latch is in the counting profile)"
+    late = ev & {"STALL", "SNAP_READY", "PERIOD_READY", "PERIOD_OVF"}
+    assert not late, f"no timing unit: events {sorted(late)}"
+    await bus.wr("GSNAP_CTRL", 0)
+    await bus.wr("PROBE_CTRL", 0)
 
 
 # ---- pytest ---------------------------------------------------------------------------------------

@@ -8,10 +8,10 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
-from cocotb.triggers import ClockCycles, FallingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, Timer
 from hedsmodel import walk
 
-from enctools.qei.bus import T_NS
+from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.model import QUAD
 
 FILTER = 2  # FILTER_LEN for the walks; states last >= 1.05 FILTER clocks
@@ -70,6 +70,24 @@ async def steps_from(env, model, start, steps):
     await env.settle(4)
     await play_clocks(env, model, step_clocks(env.pos, steps))
     await env.settle(4)
+
+
+async def illegal_jumps(env, n: int) -> None:
+    """n illegal jumps (both channels in one sample: n quadrature errors), 6 clocks apart."""
+    await env.play(walk([2] * n, [6 * T_NS] * n, start_pos=env.pos), None)
+
+
+async def rejected_pulses(env, n: int) -> None:
+    """n lone pulses of 1.5 clocks on A (one or two samples), 8 clocks apart: each rejected by a
+    FILTER_LEN of 3 or more (one GLITCH each), the position unchanged."""
+    dut = env.dut
+    for _ in range(n):
+        a = QUAD[env.pos % 4][0]
+        dut.a_in.value = 1 - a
+        await Timer(int(1.5 * PERIOD_PS) + 3, unit="ps")
+        dut.a_in.value = a
+        await Timer(8 * PERIOD_PS, unit="ps")
+    await env.settle()
 
 
 async def pulse_rst(dut, clocks=1):
