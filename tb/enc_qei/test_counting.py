@@ -15,11 +15,11 @@ from cocotb.triggers import Timer
 from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, run_feature
+from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, build_param, run_feature
 from enctools.qei.model import FUNCS, QeiModel
 from enctools.qei.stimulus import (BURST, ceilings, durations, illegal_jumps, near, rejected_pulses,
                                    steps_from, walk_with_jumps)
-from enctools.regmap import get_field, pack, regmap, units
+from enctools.regmap import enum, get_field, pack, regmap, units
 from enctools.tb import cocotb_test
 
 
@@ -337,7 +337,47 @@ async def en_off_keeps_the_rest(dut):
     await bus.wr("PROBE_CTRL", 0)
 
 
+FUNC_ALL = (1 << len(FUNCS)) - 1  # enc_qei's FUNC_MASK default: every count function
+
+
+@cocotb_test(skip=build_param("FUNC_MASK", FUNC_ALL) == FUNC_ALL)
+async def func_mask_builds(dut):
+    """A build with some count functions (enc_qei parameter FUNC_MASK; CTRL.FUNC's text): with one,
+    FUNC reads it whatever is written and counts with it; with several, FUNC reads back what was
+    written, a built function counts as the model's and one left out counts nothing (no step, no
+    QERR, on a walk with illegal jumps)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    mask = int(dut.FUNC_MASK.value)
+    built = [f for f in FUNCS if mask >> enum("CTRL", "FUNC")[f] & 1]
+    for func in FUNCS:
+        model = QeiModel(env.count_w)
+        await env.setup(model, func=built[0] if len(built) == 1 else func, count=100)
+        await bus.wr("CTRL", pack("CTRL", EN=1, FUNC=func, FILTER_LEN=FILTER))
+        await env.applied()
+        got = get_field("CTRL", "FUNC", await bus.rd("CTRL"))
+        want = enum("CTRL", "FUNC")[built[0] if len(built) == 1 else func]
+        assert got == want, f"FUNC_MASK {mask:#x}: FUNC written {func}, reads {got}, not {want}"
+        await bus.events()
+        wf = walk_with_jumps(rng, 60, env.pos, 3)
+        await env.play(wf, model if func in built or len(built) == 1 else None)
+        count, ev = await bus.count(), await bus.events()
+        if func in built or len(built) == 1:
+            assert count == model.count, f"FUNC_MASK {mask:#x}, FUNC {func}: COUNT {count}, model {model.count}"
+        else:
+            assert count == 100 and "QERR" not in ev, \
+                f"FUNC_MASK {mask:#x}, FUNC {func} left out: COUNT {count} (100), EVENTS {sorted(ev)}"
+
+
 # ---- pytest ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("config", CONFIGS, ids=CONFIG_IDS)
 def test_counting(config):
     run_feature(__name__, *config)
+
+
+@pytest.mark.parametrize("mask", (1 << 3, 1 << 0 | 1 << 3 | 1 << 5), ids=("x1a", "x4-x1a-pulse_dir"))
+def test_counting_func_mask(mask):
+    from enctools.harness import run
+
+    run("enc_qei_wb", __name__, name=f"enc_qei_wb_func_mask_{mask}", parameters={"FUNC_MASK": mask},
+        testcase="func_mask_builds")
