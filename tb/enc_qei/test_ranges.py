@@ -18,7 +18,7 @@ import pytest
 from cocotb.triggers import ClockCycles, FallingEdge
 from hedsmodel import QUAD, random_walk, walk
 
-from enctools.qei.bus import T_NS
+from enctools.qei.bus import T_NS, signed
 from enctools.qei.env import CONFIG_IDS, CONFIGS, Timebase, begin, engine_period, lacks, run_feature
 from enctools.qei.model import RANGES, QeiModel
 from enctools.qei.stimulus import BURST, WIDE, durations, near, slice_compare_cases, steps_from
@@ -181,11 +181,14 @@ async def steps_at_patterned_ceilings(dut):
 @cocotb_test(skip=lacks("RANGE"))
 async def non_recycle_stop_holds(dut):
     """non_recycle stopped at CEILING (and at 0): a RANGE change to free, modulo or limit does not
-    release it (steps both ways count nothing, STATUS.STOPPED stays 1), nor does an index preset;
-    a COUNT write does, and the new range counts from there. COUNT, EVENTS, STOPPED vs the model."""
+    release it (steps both ways count nothing and raise no OVERFLOW / UNDERFLOW, STATUS.STOPPED
+    stays 1; SNAP_DELTA still counts them), nor does an index preset; a COUNT write does, and the
+    new range counts from there. COUNT, EVENTS, STOPPED vs the model."""
     env, rng = await begin(dut)
     model = QeiModel(env.count_w)
     bus = env.bus
+
+    timing = not lacks("TIMING")
 
     async def stopped(what, want):
         await env.settle()
@@ -203,10 +206,20 @@ async def non_recycle_stop_holds(dut):
             await bus.wr("CTRL", ctrl)
             model.range = other
             await env.applied()
+            if timing:  # (the stopped counter's steps are still motion: SNAP_DELTA counts them)
+                await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+                await env.settle(4)
+                await bus.events()  # (SNAP_READY: not the model's)
             steps = [1, 1, -1, -1, -1, 1]
             await env.play(walk(steps, durations(rng, len(steps), f=1), start_pos=env.pos), model)
             await env.check(model, f"stopped, then RANGE {other}")
             await stopped(f"stopped, then RANGE {other}", 1)
+            if timing:
+                await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))
+                await env.settle(4)
+                delta = signed(await bus.rd("SNAP_DELTA"))
+                assert delta == sum(steps), f"stopped, RANGE {other}: SNAP_DELTA {delta}, motion {sum(steps)}"
+                await bus.events()
             # an index preset loads PRESET but does not release it
             await bus.set64("PRESET", 4)
             model.preset = 4
