@@ -13,14 +13,14 @@ from __future__ import annotations
 import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, Timer
 from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS, wb_abandon_read
 from enctools.qei.env import (CONFIG_IDS, CONFIGS, begin, caps_of, channel, engine_build, engine_lag,
                               lacks, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations, illegal_jumps, rejected_pulses
+from enctools.qei.stimulus import aimed_races, durations, illegal_jumps, rejected_pulses
 from enctools.regmap import addr, built_mask, event_bits, regmap, size_mask, units
 from enctools.tb import cocotb_test
 
@@ -316,46 +316,22 @@ async def count_clear_loses_no_error(dut):
         # strobe wr_c_q[k] is the k-th's)
         bit = [r.name for r in sorted(regmap().values(), key=lambda r: r.offset)
                if r.group == "chan"].index(reg)
-        got = set()
-        # the error's stimulus starts `lead` clocks after the write's; each trial aims the error
-        # at the next of 3 clocks before to 3 after the write's clock, from what the last trial
-        # measured (the AXI4-Lite master's random back-pressure moves the write), until it has
-        # come 1 clock before, in and 1 clock after it (at most 80 trials)
-        lead, aims = -10, (-3, -2, -1, 0, 1, 2, 3)
-        for n in range(80):
+
+        async def prepare():
             await bus.wr(reg, 0)
             await env.settle()
-            at = {}
 
-            async def watch():
-                for k in range(80):
-                    await RisingEdge(dut.clk)
-                    await ReadOnly()
-                    if "w" not in at and int(regs.wr_c_q.value) >> bit & 1:
-                        at["w"] = k
-                    if "e" not in at and int(pulse.value):
-                        at["e"] = k
-
-            async def error():
-                await ClockCycles(dut.clk, lead + 20)
-                await make_errors(env, reg, 1)
-
-            w, e = cocotb.start_soon(watch()), cocotb.start_soon(error())
-            await ClockCycles(dut.clk, 20)
-            await bus.wr(reg, 0)
-            await e
-            await w
+        async def judge(d, _):
             await env.settle()
             value = await bus.rd(reg)
-            d = at["e"] - at["w"]
-            got.add(d)
             assert value == int(d >= 0), \
                 f"{reg}: the error {d:+d} clocks from the clearing write's clock, the count {value}"
-            if n >= len(aims) and {-1, 0, 1} <= got:
-                break
-            lead = max(-20, min(20, lead + aims[(n + 1) % len(aims)] - d))
-        seen[reg] = sorted(got)
-        assert {-1, 0, 1} <= got, f"{reg}: the error came {sorted(got)} clocks from the write's"
+
+        # (the error's stimulus starts `lead` clocks after the write's)
+        seen[reg] = await aimed_races(dut, lambda: int(regs.wr_c_q.value) >> bit & 1,
+                                      lambda: int(pulse.value), prepare,
+                                      lambda: make_errors(env, reg, 1), lambda: bus.wr(reg, 0), judge,
+                                      lead=-10)
     dut._log.info("errors at these clocks from the clearing write's: %s", seen)
 
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import cocotb
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge
 import numpy as np
 from hedsmodel import QUAD, EncoderUnit, Profile, walk
 from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
@@ -30,7 +30,7 @@ from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
 from enctools.qei.bus import T_NS
 from enctools.qei.env import begin, build_name, channel, channel_envs, engine_build
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import pulse_rst
+from enctools.qei.stimulus import aimed_races, pulse_rst
 from enctools.regmap import enum, event_bits, get_field, pack
 from enctools.tb import cocotb_test
 
@@ -547,49 +547,30 @@ async def full_fifo_pop_in_the_push_clock(dut):
     await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
     await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1))
     await env.applied()
-    got = set()
-    lead, aims = -4, (-3, -2, -1, 0, 1, 2, 3)
-    for n in range(80):
+
+    async def prepare():
         while await bus.rd("EFIFO_STATUS") & 0x1FF < depth:  # full again
             await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
         await bus.wr("EFIFO_LOST", 0)
         await env.settle()
-        at = {}
 
-        async def watch():
-            for k in range(60):
-                await RisingEdge(dut.clk)
-                await ReadOnly()
-                if "push" not in at and int(efifo.push_q.value):
-                    at["push"] = k
-                if "pop" not in at and int(efifo.pop.value):
-                    at["pop"] = k
+    async def step():
+        await FallingEdge(dut.clk)
+        env.pos += 1
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
 
-        async def step():
-            await ClockCycles(dut.clk, lead + 20)
-            await FallingEdge(dut.clk)
-            env.pos += 1
-            dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
-
-        w, s_ = cocotb.start_soon(watch()), cocotb.start_soon(step())
-        await ClockCycles(dut.clk, 20)
-        word = await bus.rd("EFIFO_ENTRY")
-        await s_
-        await w
+    async def judge(d, word):
         await env.settle()
         lost = await bus.rd("EFIFO_LOST")
-        d = at["push"] - at["pop"]
-        got.add(d)
         e = entry_fields(word)
         assert e["VALID"] and e["LEFT"] == depth - 1, \
             f"the step's entry {d:+d} clocks from the pop: the read answered {e} (LEFT {depth - 1})"
         assert lost == int(d < 0), \
             f"a full FIFO, the step's entry written {d:+d} clocks from the pop: EFIFO_LOST {lost}"
-        if n >= len(aims) and {-1, 0, 1} <= got:
-            break
-        lead = max(-20, min(20, lead + aims[(n + 1) % len(aims)] - d))
-    assert {-1, 0, 1} <= got, f"the step's entry came {sorted(got)} clocks from the pop"
-    dut._log.info("pushes at these clocks from the pop: %s", sorted(got))
+
+    got = await aimed_races(dut, lambda: int(efifo.pop.value), lambda: int(efifo.push_q.value),
+                            prepare, step, lambda: bus.rd("EFIFO_ENTRY"), judge, lead=-4)
+    dut._log.info("pushes at these clocks from the pop: %s", got)
     await bus.wr("EFIFO_CTRL", 0)
 
 

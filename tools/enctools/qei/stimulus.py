@@ -8,7 +8,8 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
-from cocotb.triggers import ClockCycles, FallingEdge, Timer
+import cocotb
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from hedsmodel import walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
@@ -88,6 +89,48 @@ async def rejected_pulses(env, n: int) -> None:
         dut.a_in.value = a
         await Timer(8 * PERIOD_PS, unit="ps")
     await env.settle()
+
+
+async def aimed_races(dut, ref, other, prepare, stimulus, access, judge, lead: int,
+                      tries: int = 80) -> list[int]:
+    """Races between a bus access and a stimulus, timed by their effects inside the design (white
+    box): ``ref()`` and ``other()`` tell whether the access's and the stimulus's pulse is high,
+    sampled after every rising edge, and d is the clock of other's first pulse less ref's. Each
+    trial: ``prepare()``, then the access 20 clocks on and the stimulus ``lead`` clocks after the
+    access's start; ``judge(d, answer)`` asserts on the access's answer. Each trial aims d at the
+    next of -3 .. 3 from what the last one measured (a bus with random back-pressure moves the
+    access), until d has been -1, 0 and 1 (at most ``tries`` trials). Returns the d met."""
+    got = set()
+    aims = (-3, -2, -1, 0, 1, 2, 3)
+    for n in range(tries):
+        await prepare()
+        at = {}
+
+        async def watch():
+            for k in range(80):
+                await RisingEdge(dut.clk)
+                await ReadOnly()
+                for name, high in (("ref", ref), ("other", other)):
+                    if name not in at and high():
+                        at[name] = k
+
+        async def delayed():
+            await ClockCycles(dut.clk, lead + 20)
+            await stimulus()
+
+        w, s = cocotb.start_soon(watch()), cocotb.start_soon(delayed())
+        await ClockCycles(dut.clk, 20)
+        answer = await access()
+        await s
+        await w
+        d = at["other"] - at["ref"]
+        got.add(d)
+        await judge(d, answer)
+        if n >= len(aims) and {-1, 0, 1} <= got:
+            break
+        lead = max(-20, min(20, lead + aims[(n + 1) % len(aims)] - d))
+    assert {-1, 0, 1} <= got, f"the races came {sorted(got)} clocks apart, not -1, 0 and 1"
+    return sorted(got)
 
 
 async def pulse_rst(dut, clocks=1):
