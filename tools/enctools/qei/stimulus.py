@@ -240,7 +240,9 @@ class ClockWalk:
     ``p_reverse``, and its Z level is zfuns[k](position) (None: Z low). Every change is fed to the
     channel's model in order and marked on its Timeline with the timebase of its clock
     (TB_PRESCALE 0), so that a snapshot can be checked against the clock its SNAP_TIME names.
-    Walk k drives bit bits[k] of the vectors a_in, b_in, z_in (default: bit k)."""
+    Walk k drives bit bits[k] of the vectors a_in, b_in, z_in (default: bit k), starting from
+    positions[k], which must be the state its A and B pins hold; run() may be called again to go
+    on walking after a pause."""
 
     def __init__(self, dut, models, rng, positions=None, shortest=1, longest=4, p_reverse=0.2,
                  zfuns=None, bits=None):
@@ -248,7 +250,8 @@ class ClockWalk:
         n = len(models)
         self.bits = list(bits if bits is not None else range(n))
         self.pos = list(positions or [0] * n)
-        self.z = [0] * n
+        z_pins = int(dut.z_in.value)
+        self.z = [z_pins >> bit & 1 for bit in self.bits]
         self.shortest, self.longest, self.p_reverse = shortest, longest, p_reverse
         self.zfuns = zfuns or [None] * n
         self.dirs = [1] * n
@@ -276,6 +279,14 @@ class ClockWalk:
         a = int(dut.a_in.value)
         b = int(dut.b_in.value)
         z = int(dut.z_in.value)
+        # the walked bits from the walk's own state: a run started in the timestep of the last
+        # run's final write reads the pins before that write lands
+        for k in range(n):
+            bit = self.bits[k]
+            state = QUAD[self.pos[k] % 4]
+            a = a & ~(1 << bit) | state[0] << bit
+            b = b & ~(1 << bit) | state[1] << bit
+            z = z & ~(1 << bit) | self.z[k] << bit
         for _ in range(clocks):
             await FallingEdge(dut.clk)
             self.now()
