@@ -189,3 +189,71 @@ class WbRaw:
         await FallingEdge(dut.clk)
         dut.wb_cyc_i.value = dut.wb_stb_i.value = dut.wb_we_i.value = 0
         return stamp, value, err
+
+
+# The snapshot clock of a register write (the RDL text of GSNAP_CTRL), from its *write clock*: the
+# first clock of the Wishbone strobe, or the later of the AXI4-Lite AW and W handshake clocks
+WB_SNAP_LAT = 3    # Wishbone: the write clock + 3 (the clock after wb_ack_o)
+AXIL_SNAP_LAT = 5  # AXI4-Lite: the write clock + 5 (the clock s_axil_bvalid rises)
+
+
+class BusTrace:
+    """Per clock (sampled after each rising edge): the timebase, the global snapshot request, the
+    Wishbone strobe / acknowledge or the AXI4-Lite handshakes."""
+
+    def __init__(self, dut):
+        import cocotb
+
+        self.dut = dut
+        self.wb = hasattr(dut, "wb_stb_i")
+        self.rows = []
+        self.task = cocotb.start_soon(self._run())
+
+    def _sample(self) -> dict:
+        d = self.dut
+        row = {"tb": int(d.u_qei.timebase.value), "gsnap": int(d.u_qei.gsnap.value)}
+        if self.wb:
+            row["req"] = int(d.wb_cyc_i.value) & int(d.wb_stb_i.value)
+            row["resp"] = int(d.wb_ack_o.value) | int(d.wb_err_o.value)
+        else:
+            row["aw"] = int(d.s_axil_awvalid.value) & int(d.s_axil_awready.value)
+            row["w"] = int(d.s_axil_wvalid.value) & int(d.s_axil_wready.value)
+            row["resp"] = int(d.s_axil_bvalid.value)
+        return row
+
+    async def _run(self):
+        from cocotb.triggers import ReadOnly, RisingEdge
+
+        while True:
+            await RisingEdge(self.dut.clk)
+            await ReadOnly()
+            self.rows.append(self._sample())
+
+    def now(self) -> int:
+        return len(self.rows)
+
+    def first(self, key: str, after: int) -> int:
+        return next(i for i in range(after, len(self.rows)) if self.rows[i][key])
+
+    def write_clock(self, after: int) -> int:
+        """The clock the bus hands the peripheral the first write after clock ``after``."""
+        if self.wb:
+            return self.first("req", after)
+        return max(self.first("aw", after), self.first("w", after))
+
+    def clock_of(self, tb: int, after: int) -> int:
+        return next(i for i in range(after, len(self.rows)) if self.rows[i]["tb"] == tb)
+
+    def snapshots(self, after: int, before: int | None = None) -> list[int]:
+        """The clocks of the global snapshots in [after, before)."""
+        return [i for i in range(after, before or len(self.rows)) if self.rows[i]["gsnap"]]
+
+
+async def traced_write(bus, trace: BusTrace, reg: str, value: int) -> tuple[int, int]:
+    """Write ``reg``; returns (write clock, response clock)."""
+    from cocotb.triggers import ClockCycles
+
+    n0 = trace.now()
+    await bus.wr(reg, value)
+    await ClockCycles(bus.dut.clk, 2)
+    return trace.write_clock(n0), trace.first("resp", n0)
