@@ -19,11 +19,11 @@ from cocotb.simtime import get_sim_time
 from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
-from enctools.qei.bus import PERIOD_PS, T_NS, signed
+from enctools.qei.bus import AXIL_SNAP_LAT, PERIOD_PS, T_NS, WB_SNAP_LAT, BusTrace, signed, traced_write
 from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, Timebase, begin, build_param,
                               engine_build, engine_period, lacks, read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import ClockWalk, Timeline, durations
+from enctools.qei.stimulus import ClockWalk, Mark, Timeline, durations
 from enctools.regmap import event_bits, pack
 from enctools.tb import cocotb_test
 
@@ -75,7 +75,7 @@ async def snapshot_coherence(dut):
         exp_edge = trace.last_edge_time(i, edge == "a_rising")
         edges = trace.arise if edge == "a_rising" else trace.any
         if not any(edges[switched[edge] + 2:i]):
-            exp_edge = None  # no edge of the new type since EDGE changed: not defined yet
+            exp_edge = None  # no edge of the new type yet: edge_change_chooses_later_edges
         if exp_edge is not None:
             assert s["edge_time"] == exp_edge & ts_mask, \
                 f"SNAP_EDGE_TIME {s['edge_time']}, last {edge} edge at {exp_edge} (clock {i})"
@@ -156,6 +156,99 @@ async def snapshot_values_exact(dut):
     task.cancel()
     await bus.wr("SNAP_CTRL", 0)
     dut._log.info("snapshots checked: %s", seen)
+
+
+def _last_chosen(line: Timeline, t: int, switch: int, new_a: bool, old_a: bool, floor: int) -> Mark | None:
+    """The last edge a snapshot at timebase t holds when SNAP_CTRL.EDGE chose edges whose
+    timestamp (SNAP_EDGE_TIME) is ``switch`` or later by the new type (A rising: new_a) and
+    earlier ones by the old type; None when that edge would be older than ``floor``."""
+    for i in range(line._last(t), 0, -1):
+        m = line.marks[i]
+        e = m.t + line.EDGE_PIPE
+        if e < floor:
+            return None
+        if m.a_rise if (new_a if e >= switch else old_a) else m.step:
+            return m
+    return None
+
+
+@cocotb_test(skip=lacks("TIMING"))
+async def edge_change_chooses_later_edges(dut):
+    """SNAP_CTRL.EDGE changed (any <-> A rising, no CMD) while the shaft moves clock by clock
+    (FILTER_LEN 1, states of 1 to 6 clocks), then a CMD snapshot: each edge was chosen by the EDGE
+    in force when the count took it, so SNAP_EDGE_TIME is the last edge chosen that way (one of the
+    old type while no edge of the new one came) and SNAP_EDGE_DELTA the motion from the previous
+    snapshot's edge to it. On the per-channel build the new EDGE chooses exactly the edges whose
+    timestamp is the write's snapshot clock's timebase or later; with the shared engine, from the
+    channel's read that applies the write on. With the shaft at rest, a change moves nothing: a
+    snapshot after it holds the same SNAP_EDGE_TIME with SNAP_EDGE_DELTA and SNAP_DELTA 0."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    await env.setup(model, count=1000, filter_len=1)
+    await bus.wr("TB_PRESCALE", 0)
+    await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", EDGE="any"))
+    await env.applied()
+    trace = BusTrace(dut)
+    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
+    walker = ClockWalk(dut, [model], rng, positions=[env.pos], shortest=1, longest=6)
+    line = walker.lines[0]
+    ts_mask = (1 << int(dut.TS_W.value)) - 1
+    late = env.lag + 6 if env.engine else 0  # the engine applies the write at the next read
+    a_now, floor, prev, checked = False, walker.now(), None, 0
+    for trial in range(24):
+        new_a = not a_now
+        task = cocotb.start_soon(walker.run(rng.randint(80, 300)))
+        await ClockCycles(dut.clk, rng.randint(2, 60))
+        ctrl = pack("SNAP_CTRL", EDGE="a_rising" if new_a else "any")
+        wclk, _ = await traced_write(bus, trace, "SNAP_CTRL", ctrl)
+        switch = walker.unwrap(trace.rows[wclk + lat]["tb"])  # (the write's snapshot clock)
+        # (mostly soon after the change: the edges near it tell where the new EDGE starts)
+        await ClockCycles(dut.clk, rng.choice((1, 1, 2, 3, 4, 6, rng.randint(8, 80))))
+        await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
+        await env.settle(8)
+        snap = await read_snapshot(bus)
+        t = walker.unwrap(snap["time"])
+        what = f"trial {trial}, EDGE to {'a_rising' if new_a else 'any'} at timebase {switch & ts_mask:#x}, " \
+            f"snapshot at {snap['time']:#x}"
+        cands = {}
+        for sw in range(switch, switch + late + 1):
+            m = _last_chosen(line, t, sw, new_a, a_now, floor)
+            if m is not None:
+                cands[(m.t + line.EDGE_PIPE) & ts_mask] = m
+        if cands:  # (else the last chosen edge is older than the walk so far: not judged)
+            assert snap["edge_time"] in cands, \
+                f"{what}: SNAP_EDGE_TIME {snap['edge_time']:#x}, the last chosen edge at " \
+                f"{[hex(c) for c in cands]}"
+            e = cands[snap["edge_time"]]
+            if prev is not None:
+                assert signed(snap["edge_delta"]) == e.motion - prev.motion, \
+                    f"{what}: SNAP_EDGE_DELTA {signed(snap['edge_delta'])}, the motion from the " \
+                    f"previous snapshot's edge {e.motion - prev.motion}"
+            checked += 1
+        prev = cands.get(snap["edge_time"])
+        await task
+        env.pos = walker.pos[0]
+        a_now, floor = new_a, switch + late + 1
+        if trial % 3 == 2:  # at rest: a change moves nothing
+            await env.settle(8)
+            await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
+            await env.settle(8)
+            before = await read_snapshot(bus)
+            a_now = not a_now
+            ctrl = pack("SNAP_CTRL", EDGE="a_rising" if a_now else "any")
+            await bus.wr("SNAP_CTRL", ctrl)
+            await env.applied()
+            await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
+            await env.settle(8)
+            after = await read_snapshot(bus)
+            assert (after["edge_time"], after["edge_delta"], after["delta"]) == (before["edge_time"], 0, 0), \
+                f"trial {trial}: EDGE changed at rest: SNAP_EDGE_TIME {before['edge_time']:#x} -> " \
+                f"{after['edge_time']:#x}, SNAP_EDGE_DELTA {after['edge_delta']:#x}, SNAP_DELTA {after['delta']:#x}"
+            prev = None
+    assert checked >= 16, f"only {checked} of 24 snapshots judged"
+    trace.task.cancel()
+    await bus.wr("SNAP_CTRL", 0)
 
 
 @cocotb_test(skip=lacks("TIMING"))
