@@ -251,6 +251,46 @@ async def reset_mid_window(dut):
 
 
 @cocotb_test()
+async def leds_dark_until_first_transition(dut):
+    """After rst both LEDs stay 0 while the shaft stands (any of the four states, held for a
+    random time) and across a double change (both channels in one clock: no direction); the first
+    valid transition lights the LED of its direction within 8 clocks and only that one. Both
+    directions, from each state."""
+    await start_clock(dut)
+    rng = random.Random(log_seed(dut))
+    quad = [(0, 0), (1, 0), (1, 1), (0, 1)]  # forward: A leads
+    for trial in range(8):
+        k = rng.randrange(4)
+        forward = trial % 2 == 0
+        await FallingEdge(dut.clk)
+        dut.a.value, dut.b.value = quad[k]
+        await reset(dut, 2)
+        lit = []
+        for _ in range(rng.randint(10, 60)):  # standing
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            lit.append((int(dut.a_leads.value), int(dut.b_leads.value)))
+        await FallingEdge(dut.clk)
+        far = quad[(k + 2) % 4]  # both channels at once
+        dut.a.value, dut.b.value = far
+        for _ in range(12):
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            lit.append((int(dut.a_leads.value), int(dut.b_leads.value)))
+        assert set(lit) == {(0, 0)}, f"trial {trial}: an LED lit before a valid transition: {sorted(set(lit))}"
+        await FallingEdge(dut.clk)
+        dut.a.value, dut.b.value = quad[(k + 2 + (1 if forward else -1)) % 4]
+        after = []
+        for _ in range(8):
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            after.append((int(dut.a_leads.value), int(dut.b_leads.value)))
+        want = (1, 0) if forward else (0, 1)
+        assert set(after) <= {(0, 0), want} and after[-1] == want, \
+            f"trial {trial}: {'forward' if forward else 'reverse'} transition from {far}: LEDs {after}"
+
+
+@cocotb_test()
 async def direction_change_mid_window(dut):
     """Reverse in mid-window: the LEDs swap, the mixed window gives no reading, later ones are right."""
     await start_clock(dut)

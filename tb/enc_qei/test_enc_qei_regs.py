@@ -140,8 +140,16 @@ def test_rdl_has_the_contract_names():
                                     "decrease", "x1_hyst"}
     assert enum("CTRL", "RANGE") == {"free", "modulo", "limit", "non_recycle"}
     assert enum("INDEX_CTRL", "ACTION") == {"none", "preset", "latch"}
-    for field in ("EN", "SWAP_AB", "INV_A", "INV_B", "INV_Z", "FILTER_LEN"):
-        assert regs["CTRL"].get_child_by_name(field) is not None, field
+    # the fields the contract names (STATUS: filtered A, B, Z, direction, index armed, stalled;
+    # INDEX_CTRL: one-shot, edge, the gate; PROBE_CTRL: the edge, optionally once)
+    for reg, fields in (("CTRL", ("EN", "SWAP_AB", "INV_A", "INV_B", "INV_Z", "FILTER_LEN")),
+                        ("STATUS", ("A", "B", "Z", "DIR", "INDEX_ARMED", "STALLED")),
+                        ("INDEX_CTRL", ("ACTION", "ONESHOT", "EDGE", "GATE_EN", "GATE_A", "GATE_B", "ARM")),
+                        ("PROBE_CTRL", ("EN", "EDGE", "ONCE"))):
+        for field in fields:
+            assert regs[reg].get_child_by_name(field) is not None, f"{reg}.{field}"
+    assert {m.name for m in regs["INDEX_CTRL"].get_child_by_name("EDGE").get_property("encode")} \
+        == {"rising", "falling"}
     events = {f.inst_name for f in regs["EVENTS"].fields()}
     # the contract's events, and the edge FIFO's (a build without it: they never fire)
     assert events == {"OVERFLOW", "UNDERFLOW", "INDEX", "PROBE", "CMP", "QERR", "GLITCH",
