@@ -4,7 +4,8 @@ enctools.benches.count_rate_qei): one channel on each adapter, and the shared en
 with 16 lean channels, each playing its own walk at once: exact at 1.05 x the bound for
 FILTER_LEN 1 .. 4, and every inexact channel flagged at 0.8 x (on Verilator whatever SIM says:
 Icarus takes about 30 times longer). The single-channel builds also run every count function at
-its bound (the A-edge functions need every level of A to last 1.05 FILTER_LEN clocks)."""
+its bound (the A-edge functions need every level of A to last 1.05 FILTER_LEN clocks) and past
+it (never_silent: exact or flagged)."""
 
 import pytest
 

@@ -11,10 +11,10 @@ Every cocotb test logs its seed (make test SEED=n reproduces a run).
 from __future__ import annotations
 
 import pytest
-from cocotb.triggers import Timer
+from cocotb.triggers import ClockCycles, RisingEdge, Timer
 from hedsmodel import QUAD, EncoderUnit, Profile, random_walk, walk, with_glitches
 
-from enctools.qei.bus import T_NS
+from enctools.qei.bus import PERIOD_PS, T_NS
 from enctools.qei.env import CONFIG_IDS, CONFIGS, FILTER, begin, build_param, run_feature
 from enctools.qei.model import FUNCS, QeiModel
 from enctools.qei.stimulus import (BURST, ceilings, durations, illegal_jumps, near, rejected_pulses,
@@ -189,6 +189,41 @@ async def filter_len_clamp(dut):
         ev = await bus.events()
         assert "QERR" not in ev, f"FILTER_LEN {f}: QERR"
         model.take_events()
+
+
+@cocotb_test()
+async def sub_clock_a_pulse_unseen(dut):
+    """An A pulse between two clock edges (high from 0.3 to 0.7 of a clock period after a rising
+    edge, B steady at 1) is never sampled: pulse_dir (FILTER_LEN 1 and 3) and x4 count nothing for
+    it and no QERR or GLITCH is raised (CTRL.FILTER_LEN's text: such a pulse is not seen at all).
+    The same pulse made 1.5 clocks long is sampled: pulse_dir counts it (FILTER_LEN 1)."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    model = QeiModel(env.count_w)
+    while QUAD[env.pos % 4] != (0, 1):  # A low, B high (pulse_dir: up)
+        await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+
+    async def pulses(n: int, clocks: float) -> None:
+        for _ in range(n):
+            await RisingEdge(dut.clk)
+            await Timer(int(0.3 * PERIOD_PS), unit="ps")
+            dut.a_in.value = 1
+            await Timer(int(clocks * PERIOD_PS), unit="ps")
+            dut.a_in.value = 0
+            await ClockCycles(dut.clk, rng.randint(4, 9))
+
+    for func, f, clocks, counted in (("pulse_dir", 1, 0.4, 0), ("pulse_dir", 3, 0.4, 0),
+                                     ("x4", 1, 0.4, 0), ("pulse_dir", 1, 1.5, 1)):
+        await env.setup(model, func=func, filter_len=f, count=0)
+        await bus.events()
+        n = rng.randint(3, 6)
+        await pulses(n, clocks)
+        await env.settle(12)
+        what = f"{func}, FILTER_LEN {f}: {n} A pulses of {clocks} clocks"
+        assert await bus.count() == counted * n, f"{what}: COUNT {await bus.count()}"
+        ev = await bus.events()
+        assert not {"QERR", "GLITCH"} & ev, f"{what}: events {sorted(ev)}"
+        assert await bus.rd("GLITCH_COUNT") == 0, f"{what}: GLITCH_COUNT"
 
 
 @cocotb_test()
