@@ -474,6 +474,58 @@ async def en_off_keeps_lost_forgets_idx(dut):
 
 
 @cocotb_test()
+async def clear_forgets_marks(dut):
+    """EFIFO_CTRL.CLEAR written with EN = 1 empties the FIFO and forgets a pending LOST mark and a
+    pending IDX mark, and leaves EFIFO_LOST and EFIFO_TIME as they were: after an overrun (a loss
+    pending, one entry popped) and a CLEAR, the next walk's entries have LOST = 0 and EFIFO_LOST
+    still counts the lost steps; an index edge with the shaft standing (Z rising, INDEX_CTRL EDGE
+    rising, ACTION none) marks the next entry stored (IDX = 1) without a CLEAR in between and
+    marks nothing when a CLEAR comes between."""
+    fifo, _, rng = await fifo_of(dut)
+    bus = fifo.bus
+    await fifo.start()
+    await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
+    await fifo.env.applied()
+    clear = pack("EFIFO_CTRL", EN=1, CLEAR=1, THRESH=1)
+
+    async def index_edge(z):  # Z to z with the shaft standing
+        fifo.env.drv.set_state(*QUAD[fifo.env.pos % 4], z)
+        await fifo.env.settle()
+
+    async def after(what):  # two steps on: the entries' (LOST, IDX)
+        wf, steps = fifo.walk(rng, 2, 3, 8, p_rev=0.0)
+        await fifo.play(wf)
+        await ClockCycles(dut.clk, 12)
+        entries = await fifo.drain()
+        match(entries, steps, fifo.ts_w, 0, what)
+        return [(e["LOST"], e["IDX"]) for e in entries]
+
+    # a pending LOST mark
+    wf, _ = fifo.walk(rng, fifo.depth + 2, 3, 8)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    time = (await fifo.pop())["TIME"]
+    await bus.wr("EFIFO_CTRL", clear)
+    assert await fifo.level() == 0, "CLEAR left entries"
+    assert await bus.rd("EFIFO_TIME") == time, "CLEAR changed EFIFO_TIME"
+    assert await bus.rd("EFIFO_LOST") == 2, "CLEAR changed EFIFO_LOST"
+    got = await after("after CLEAR with a loss pending")
+    assert got == [(0, 0), (0, 0)], f"(LOST, IDX) after CLEAR with a loss pending: {got}"
+    assert await bus.rd("EFIFO_LOST") == 2
+    # a pending IDX mark: kept without a CLEAR (the control), forgotten with one
+    await index_edge(1)
+    got = await after("an index edge with the shaft standing")
+    assert got == [(0, 1), (0, 0)], f"(LOST, IDX) after an index edge, no CLEAR: {got}"
+    await index_edge(0)
+    await index_edge(1)
+    await bus.wr("EFIFO_CTRL", clear)
+    got = await after("after CLEAR with an index mark pending")
+    assert got == [(0, 0), (0, 0)], f"(LOST, IDX) after CLEAR with an index mark pending: {got}"
+    assert await bus.rd("EFIFO_LOST") == 2
+    await index_edge(0)
+
+
+@cocotb_test()
 async def reset_with_entries(dut):
     """rst while the FIFO holds entries, a loss is pending and the shaft moves: after it the FIFO
     is empty, EFIFO_TIME and EFIFO_LOST read 0, EN is off; enabled again (no CLEAR) it stores the
@@ -532,6 +584,38 @@ async def index_marks_its_entry(dut):
     dut._log.info("%d entries, %d with IDX", len(entries), sum(expect))
 
 
+@cocotb_test()
+async def lost_step_passes_its_idx_mark(dut):
+    """An index edge made by a step lost to a full FIFO (Z rising with the transition, INDEX_CTRL
+    EDGE rising, ACTION none) marks the next entry stored: depth + 3 steps with no reads, Z rising
+    with the second lost step; the stored steps have IDX = 0, and after the drain the next entry
+    has LOST = 1 and IDX = 1, the one after it neither."""
+    fifo, _, rng = await fifo_of(dut)
+    await fifo.start()
+    await fifo.bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="none", EDGE="rising"))
+    await fifo.env.applied()
+    wf, steps = fifo.walk(rng, fifo.depth + 3, 3, 8)
+    rise = fifo.depth + 1  # the step Z rises with (steps depth .. depth + 2 are lost)
+    index = [(t, int(k > rise)) for k, (t, _, _) in enumerate(wf.events)]  # (event k + 1: step k)
+    await FallingEdge(dut.clk)
+    await fifo.env.drv.play(wf, index=index)
+    fifo.env.pos = wf.positions[-1]
+    await fifo.env.settle()
+    assert "INDEX" in await fifo.bus.events(), "the Z edge is an index"
+    assert await fifo.bus.rd("EFIFO_LOST") == 3
+    entries = await fifo.drain()
+    match(entries, steps[:fifo.depth], fifo.ts_w, 0, "the stored steps")
+    assert not any(e["IDX"] for e in entries), f"IDX on a stored step: {[e['IDX'] for e in entries]}"
+    wf, more = fifo.walk(rng, 2, 3, 8)
+    await fifo.play(wf)
+    await ClockCycles(dut.clk, 12)
+    after = await fifo.drain()
+    match([dict(e, LOST=0) for e in after], more, fifo.ts_w, 0, "after the gap")  # (LOST below)
+    assert [(e["LOST"], e["IDX"]) for e in after] == [(1, 1), (0, 0)], \
+        f"(LOST, IDX) after the gap: {[(e['LOST'], e['IDX']) for e in after]}"
+    fifo.env.drv.set_state(*QUAD[fifo.env.pos % 4], 0)
+
+
 @cocotb_test(skip=engine_build())
 async def full_fifo_pop_in_the_push_clock(dut):
     """A full FIFO and a step against an EFIFO_ENTRY read (white box, per-channel build: the
@@ -571,6 +655,121 @@ async def full_fifo_pop_in_the_push_clock(dut):
     got = await aimed_races(dut, lambda: int(efifo.pop.value), lambda: int(efifo.push_q.value),
                             prepare, step, lambda: bus.rd("EFIFO_ENTRY"), judge, lead=-4)
     dut._log.info("pushes at these clocks from the pop: %s", got)
+    await bus.wr("EFIFO_CTRL", 0)
+
+
+@cocotb_test(skip=engine_build())
+async def ctrl_and_lost_write_clocks(dut):
+    """The clocks a write of EFIFO_CTRL and of EFIFO_LOST acts in (white box, per-channel build:
+    the clock r of the write's request, on Wishbone the strobe's first clock, on AXI4-Lite the
+    request into enc_qei, and the clock s of a step, the core's step pulse, sampled every clock;
+    the step's entry is written in s + 1; the write's snapshot clock is r + 3 on both buses).
+    EN = 1 (from 0) stores the steps with s >= r + 2 (entry clock >= r + 3) and none before;
+    EN = 0 (from 1) stores the steps with s <= r + 1 (entry clock <= r + 2) and none after; CLEAR
+    (with EN = 1, the FIFO full) removes or drops every step with s <= r + 1 and stores those with
+    s >= r + 2: a step with s <= r is lost before it (EFIFO_LOST 1), the one with s = r + 1 (entry
+    clock r + 2, the clear's) is neither stored nor lost; a write of EFIFO_LOST clears the losses
+    of the steps with s <= r - 1 (entry clock <= r) and counts those with s >= r (entry clock
+    >= r + 1: the value becomes 1). Each boundary is met from both sides, steps aimed at -3 .. 3
+    clocks around it."""
+    envs, rng = await _start(dut)
+    env = envs[0]
+    bus = env.bus
+    depth = 1 << int(dut.EFIFO_LOG2.value)
+    efifo = channel(dut).g_efifo.u_efifo
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    if bus.kind == "wb":
+        def request():
+            return int(dut.wb_cyc_i.value) & int(dut.wb_stb_i.value)
+    else:  # (the later AW / W handshake + 2: the adapter is idle)
+        def request():
+            return int(dut.u_qei.req_valid.value)
+
+    def stepped():
+        return int(efifo.step_up.value) | int(efifo.step_dn.value)
+
+    async def one_step():
+        await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+
+    async def step():
+        await FallingEdge(dut.clk)
+        env.pos += 1
+        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
+
+    async def race(what, prepare, access, outcome, first):
+        """Steps aimed at s = r + first - 3 .. r + first + 3: ``outcome(s - r)`` after each must
+        be 1 iff s >= r + first (aimed_races's d is s - (r + first): its reference is the clock
+        ``first`` clocks after the request's first clock)."""
+        seen = []  # the clocks sampled since the request's first one
+
+        def boundary():  # (aimed_races asks once a clock until it answers 1)
+            if seen or request():
+                seen.append(1)
+            return int(len(seen) == first + 1)
+
+        async def arm():
+            seen.clear()
+            await prepare()
+
+        async def judge(d, _):
+            await env.settle()
+            got = await outcome(first + d)
+            assert got == int(d >= 0), \
+                f"{what}: a step at s = r{first + d:+d}: {got}, expected {int(d >= 0)}"
+
+        got = await aimed_races(dut, boundary, stepped, arm, step, access, judge, lead=-4 - first)
+        dut._log.info("%s: steps at s = r + %s", what, [first + d for d in got])
+
+    def ctrl(en, clear=0):
+        return lambda: bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=en, CLEAR=clear))
+
+    async def level(_=None):
+        return await bus.rd("EFIFO_STATUS")
+
+    async def empty(_):
+        return int(await level() == 0)
+
+    async def emptied(en):
+        await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=en, CLEAR=1))
+        await bus.wr("EFIFO_LOST", 0)
+        await env.settle()
+
+    # EN on: the step is an entry (LEVEL 1) iff s >= r + 2
+    await race("EN = 1", lambda: emptied(0), ctrl(1), level, 2)
+    # EN off: the step is not an entry iff s >= r + 2
+    await race("EN = 0", lambda: emptied(1), ctrl(0), empty, 2)
+
+    # CLEAR, the FIFO full: the step is the one entry after it iff s >= r + 2; before, it is lost
+    # iff s <= r (the one with s = r + 1 is dropped by the clear, no loss)
+    async def full():
+        await emptied(1)
+        while await level() < depth:
+            await one_step()
+
+    async def cleared(s):
+        n, lost = await level(), await bus.rd("EFIFO_LOST")
+        if n:
+            e = entry_fields(await bus.rd("EFIFO_ENTRY"))
+            assert n == 1 and e["LOST"] == 0 and lost == 0, \
+                f"after CLEAR: LEVEL {n}, the entry {e}, EFIFO_LOST {lost} (a step at s = r{s:+d})"
+        else:
+            assert lost == int(s <= 0), f"CLEAR: a step at s = r{s:+d} not stored: EFIFO_LOST {lost}"
+        return n
+    await race("CLEAR", full, ctrl(1, 1), cleared, 2)
+
+    # EFIFO_LOST: a full FIFO, two steps lost before; the step's loss stays counted iff s >= r
+    async def full_and_lost():
+        await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1))
+        while await level() < depth:
+            await one_step()
+        await one_step()
+        await one_step()
+        await env.settle()
+        assert await bus.rd("EFIFO_LOST") >= 2
+
+    async def lost(_):
+        return await bus.rd("EFIFO_LOST")
+    await race("EFIFO_LOST", full_and_lost, lambda: bus.wr("EFIFO_LOST", 0), lost, 0)
     await bus.wr("EFIFO_CTRL", 0)
 
 
