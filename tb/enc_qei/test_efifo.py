@@ -155,6 +155,15 @@ async def _start(dut):
     return channel_envs(dut, rng, int(dut.CHANNELS.value)), rng
 
 
+async def _white_box(dut):
+    """Channel 0 counting x4 from 0 at FILTER_LEN 1, for the white-box tests: (its Env, rng, the
+    FIFO's depth, the per-channel build's enc_qei_efifo instance)."""
+    envs, rng = await _start(dut)
+    env = envs[0]
+    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
+    return env, rng, 1 << int(dut.EFIFO_LOG2.value), channel(dut).g_efifo.u_efifo
+
+
 @cocotb_test()
 async def entries_match_the_walk(dut):
     """A random walk (reversals at any state) read back in full: every step in order with its
@@ -623,12 +632,8 @@ async def full_fifo_pop_in_the_push_clock(dut):
     after the step (its timestamp clock); it is stored when the read pops in that clock or before
     and dropped (EFIFO_LOST 1) only when the pop comes later (EFIFO_CTRL's text). The read's LEFT
     never counts an entry written in its own clock (depth - 1 every time)."""
-    envs, rng = await _start(dut)
-    env = envs[0]
+    env, rng, depth, efifo = await _white_box(dut)
     bus = env.bus
-    depth = 1 << int(dut.EFIFO_LOG2.value)
-    efifo = channel(dut).g_efifo.u_efifo
-    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
     await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1, CLEAR=1))
     await env.applied()
 
@@ -672,12 +677,8 @@ async def ctrl_and_lost_write_clocks(dut):
     of the steps with s <= r - 1 (entry clock <= r) and counts those with s >= r (entry clock
     >= r + 1: the value becomes 1). Each boundary is met from both sides, steps aimed at -3 .. 3
     clocks around it."""
-    envs, rng = await _start(dut)
-    env = envs[0]
+    env, rng, depth, efifo = await _white_box(dut)
     bus = env.bus
-    depth = 1 << int(dut.EFIFO_LOG2.value)
-    efifo = channel(dut).g_efifo.u_efifo
-    await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
     if bus.kind == "wb":
         def request():
             return int(dut.wb_cyc_i.value) & int(dut.wb_stb_i.value)

@@ -45,6 +45,15 @@ TIMER_START = -1  # PERIOD_EN 0 -> 1: the timer counts from the clock before the
 PERIOD_LAG = 1  # a new GSNAP_PERIOD: used for periods that start after the write's snapshot clock
 
 
+async def traced_begin(dut):
+    """begin(), TB_PRESCALE 0 (a tick a clock) and a BusTrace: (env, rng, trace, the bus's
+    snapshot latency, WB_SNAP_LAT or AXIL_SNAP_LAT)."""
+    env, rng = await begin(dut)
+    await env.bus.wr("TB_PRESCALE", 0)
+    trace = BusTrace(dut)
+    return env, rng, trace, WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
+
+
 def check_deferred(requests, taken, p, what) -> None:
     """The shared engine's global snapshots: each request (a clock) is taken in its clock, or,
     while the capture of the snapshot before (at most p clocks before) waits for its visit, in
@@ -70,12 +79,9 @@ async def cmd_snapshot_clock(dut):
     WB_SNAP_LAT or AXIL_SNAP_LAT, the clock of the Wishbone acknowledge or the one before BVALID (with the
     shared engine, writes P clocks further apart, and SNAP_CTRL.CMD: from the write clock + that
     to the write clock + P + 18)."""
-    env, rng = await begin(dut)
+    env, rng, trace, lat = await traced_begin(dut)
     channels = int(dut.CHANNELS.value)
     bus = env.bus
-    await bus.wr("TB_PRESCALE", 0)
-    trace = BusTrace(dut)
-    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
     found = {}
     for reg, time_reg in (("GSNAP_CTRL", "GSNAP_TIME"), ("SNAP_CTRL", "SNAP_TIME")):
         for _ in range(12):
@@ -101,12 +107,9 @@ async def period_en_rewrite_and_restart(dut):
     such a rewrite is a snapshot of its own in its snapshot clock; PERIOD_EN
     written 0 and then 1 restarts it, the first snapshot P clocks after the write's snapshot
     clock. (The shared engine: a snapshot may be deferred, check_deferred.)"""
-    env, rng = await begin(dut)
+    env, rng, trace, lat = await traced_begin(dut)
     channels = int(dut.CHANNELS.value)
     bus = env.bus
-    await bus.wr("TB_PRESCALE", 0)
-    trace = BusTrace(dut)
-    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
     for period in (rng.randint(60, 90), rng.randint(150, 200)):
         await bus.wr("GSNAP_PERIOD", period)
         wclk, _ = await traced_write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
@@ -166,11 +169,8 @@ async def new_period_after_the_one_in_progress(dut):
     before the end of the period in progress (aimed at d = -2 .. 11 and four random d): the timer
     snapshot that ends it comes at the old length; the following period is the new one when
     d >= PERIOD_LAG, else the old one once more; the one after that is the new one."""
-    env, rng = await begin(dut)
+    env, rng, trace, lat = await traced_begin(dut)
     bus = env.bus
-    await bus.wr("TB_PRESCALE", 0)
-    trace = BusTrace(dut)
-    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
     p1, p2 = rng.randint(70, 90), rng.randint(100, 120)
     await bus.wr("GSNAP_PERIOD", p1)
     await traced_write(bus, trace, "GSNAP_CTRL", pack("GSNAP_CTRL", PERIOD_EN=1))
@@ -216,12 +216,9 @@ async def period_zero_acts_as_one(dut):
     snapshot in every clock from the write's snapshot clock on (the snapshot clock + GSNAP_PERIOD
     - 1), the same for both values, until PERIOD_EN is written 0 (the shared engine: requests in
     every clock, taken as check_deferred allows)."""
-    env, rng = await begin(dut)
+    env, rng, trace, lat = await traced_begin(dut)
     channels = int(dut.CHANNELS.value)
     bus = env.bus
-    await bus.wr("TB_PRESCALE", 0)
-    trace = BusTrace(dut)
-    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
     p = engine_period(channels) if env.engine else 0
     for period in (0, 1, 0):
         await bus.wr("GSNAP_PERIOD", period)
@@ -251,11 +248,8 @@ async def prescale_write_restarts_the_count(dut):
     clocks (the first tick in S + Q + 1); before S it keeps the old pace (a tick of the old grid
     may still come in S - 1). A write of the value it holds changes nothing: the ticks keep their
     grid across it."""
-    env, rng = await begin(dut)
+    env, rng, trace, lat = await traced_begin(dut)
     bus = env.bus
-    await bus.wr("TB_PRESCALE", 0)
-    trace = BusTrace(dut)
-    lat = WB_SNAP_LAT if trace.wb else AXIL_SNAP_LAT
     cur, seen = 0, set()
     for trial in range(16):
         new = rng.choice((0, 1, 2, 3, 6, 9, cur))
