@@ -28,7 +28,7 @@ from hedsmodel import QUAD, EncoderUnit, Profile, walk
 from hedsmodel.velocity import Timebase, edge_table, ideal_edge_entries
 
 from enctools.qei.bus import T_NS
-from enctools.qei.env import begin, build_name, channel, channel_envs, engine_build
+from enctools.qei.env import begin, build_name, channel, channel_envs
 from enctools.qei.model import QeiModel
 from enctools.qei.stimulus import aimed_races, pulse_rst
 from enctools.regmap import enum, event_bits, get_field, pack
@@ -157,11 +157,15 @@ async def _start(dut):
 
 async def _white_box(dut):
     """Channel 0 counting x4 from 0 at FILTER_LEN 1, for the white-box tests: (its Env, rng, the
-    FIFO's depth, the per-channel build's enc_qei_efifo instance)."""
+    FIFO's depth, its enc_qei_efifo instance: in the channel, or with the shared engine in the
+    bank beside it)."""
     envs, rng = await _start(dut)
     env = envs[0]
     await env.setup(QeiModel(env.count_w), count=0, filter_len=1)
-    return env, rng, 1 << int(dut.EFIFO_LOG2.value), channel(dut).g_efifo.u_efifo
+    qei = dut.u_qei
+    efifo = (qei.g_engine.g_efifo.u_efifo_bank.g_ch[0].u_efifo if hasattr(qei, "g_engine")
+             else channel(dut).g_efifo.u_efifo)
+    return env, rng, 1 << int(dut.EFIFO_LOG2.value), efifo
 
 
 @cocotb_test()
@@ -625,9 +629,9 @@ async def lost_step_passes_its_idx_mark(dut):
     fifo.env.drv.set_state(*QUAD[fifo.env.pos % 4], 0)
 
 
-@cocotb_test(skip=engine_build())
+@cocotb_test()
 async def full_fifo_pop_in_the_push_clock(dut):
-    """A full FIFO and a step against an EFIFO_ENTRY read (white box, per-channel build: the
+    """A full FIFO and a step against an EFIFO_ENTRY read (white box, on both architectures: the
     FIFO's push and pop clocks sampled every clock): the step's entry is written in the clock
     after the step (its timestamp clock); it is stored when the read pops in that clock or before
     and dropped (EFIFO_LOST 1) only when the pop comes later (EFIFO_CTRL's text). The read's LEFT
@@ -663,11 +667,11 @@ async def full_fifo_pop_in_the_push_clock(dut):
     await bus.wr("EFIFO_CTRL", 0)
 
 
-@cocotb_test(skip=engine_build())
+@cocotb_test()
 async def ctrl_and_lost_write_clocks(dut):
-    """The clocks a write of EFIFO_CTRL and of EFIFO_LOST acts in (white box, per-channel build:
+    """The clocks a write of EFIFO_CTRL and of EFIFO_LOST acts in (white box, on both architectures:
     the clock r of the write's request, on Wishbone the strobe's first clock, on AXI4-Lite the
-    request into enc_qei, and the clock s of a step, the core's step pulse, sampled every clock;
+    request into enc_qei, and the clock s of a step, the FIFO's step input, sampled every clock;
     the step's entry is written in s + 1; the write's snapshot clock is r + 3 on both buses).
     EN = 1 (from 0) stores the steps with s >= r + 2 (entry clock >= r + 3) and none before;
     EN = 0 (from 1) stores the steps with s <= r + 1 (entry clock <= r + 2) and none after; CLEAR
