@@ -4,8 +4,8 @@ GSNAP_CTRL / GSNAP_PERIOD say it:
 
 - the clock of a CMD write's snapshot, counted one way for both buses: the *write clock* is the
   first clock of the Wishbone strobe, or the clock of the later of the AXI4-Lite AW and W
-  handshakes; the snapshot is taken WB_SNAP_LAT (Wishbone) or AXIL_SNAP_LAT (AXI4-Lite) clocks after it,
-  which is the clock of wb_ack_o, or the clock before s_axil_bvalid rises; a channel's own
+  handshakes; the snapshot is taken WB_SNAP_LAT (Wishbone) or AXIL_SNAP_LAT (AXI4-Lite) clocks
+  after it, which is the clock after wb_ack_o, or the clock s_axil_bvalid rises; a channel's own
   SNAP_CTRL.CMD takes its snapshot in the same clock;
 - PERIOD_EN written 1 while it is 1 does not restart the unit timer; a 0 -> 1 write starts it,
   its first snapshot GSNAP_PERIOD ticks after the write's snapshot clock (the clock a CMD in that
@@ -76,9 +76,9 @@ def check_deferred(requests, taken, p, what) -> None:
 async def cmd_snapshot_clock(dut):
     """GSNAP_CTRL.CMD and a channel's SNAP_CTRL.CMD, twelve writes each at random distances:
     the snapshot clock (where GSNAP_TIME / SNAP_TIME take the timebase) is the write clock +
-    WB_SNAP_LAT or AXIL_SNAP_LAT, the clock of the Wishbone acknowledge or the one before BVALID (with the
-    shared engine, writes P clocks further apart, and SNAP_CTRL.CMD: from the write clock + that
-    to the write clock + P + 18)."""
+    WB_SNAP_LAT or AXIL_SNAP_LAT, the clock after the Wishbone acknowledge or the one BVALID
+    rises in (with the shared engine, writes P clocks further apart, and SNAP_CTRL.CMD: from the
+    write clock + that to the write clock + P + 18)."""
     env, rng, trace, lat = await traced_begin(dut)
     channels = int(dut.CHANNELS.value)
     bus = env.bus
