@@ -16,7 +16,7 @@ from __future__ import annotations
 import cocotb
 import pytest
 from cocotb.simtime import get_sim_time
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import AXIL_SNAP_LAT, PERIOD_PS, T_NS, WB_SNAP_LAT, BusTrace, signed, traced_write
@@ -179,8 +179,9 @@ async def edge_change_chooses_later_edges(dut):
     in force when the count took it, so SNAP_EDGE_TIME is the last edge chosen that way (one of the
     old type while no edge of the new one came) and SNAP_EDGE_DELTA the motion from the previous
     snapshot's edge to it. On the per-channel build the new EDGE chooses exactly the edges whose
-    timestamp is the write's snapshot clock's timebase or later; with the shared engine, from the
-    channel's read that applies the write on. With the shaft at rest, a change moves nothing: a
+    timestamp is the write's snapshot clock's timebase or later; with the shared engine, the edges
+    the count takes from the clock of the channel's read that applies the write on (channel 0's
+    reads watched, white box; half the snapshots then by snap_in just after that read). With the shaft at rest, a change moves nothing: a
     snapshot after it holds the same SNAP_EDGE_TIME with SNAP_EDGE_DELTA and SNAP_DELTA 0."""
     env, rng = await begin(dut)
     bus = env.bus
@@ -195,24 +196,50 @@ async def edge_change_chooses_later_edges(dut):
     line = walker.lines[0]
     ts_mask = (1 << int(dut.TS_W.value)) - 1
     late = env.lag + 6 if env.engine else 0  # the engine applies the write at the next read
+    reads = []  # the engine: the timebase of every read of channel 0 (white box)
+    if env.engine:
+        lane = dut.u_qei.g_engine.u_engine.g_lane[0].u_lane
+
+        async def watch_reads():
+            while True:
+                await RisingEdge(dut.clk)
+                await ReadOnly()
+                if int(lane.rd.value):
+                    reads.append(walker.now())
+        watcher = cocotb.start_soon(watch_reads())
     a_now, floor, prev, checked = False, walker.now(), None, 0
     for trial in range(24):
         new_a = not a_now
         task = cocotb.start_soon(walker.run(rng.randint(80, 300)))
         await ClockCycles(dut.clk, rng.randint(2, 60))
-        ctrl = pack("SNAP_CTRL", EDGE="a_rising" if new_a else "any")
+        ctrl = pack("SNAP_CTRL", EDGE="a_rising" if new_a else "any", IN_EN=1)
         wclk, _ = await traced_write(bus, trace, "SNAP_CTRL", ctrl)
         switch = walker.unwrap(trace.rows[wclk + lat]["tb"])  # (the write's snapshot clock)
-        # (mostly soon after the change: the edges near it tell where the new EDGE starts)
-        await ClockCycles(dut.clk, rng.choice((1, 1, 2, 3, 4, 6, rng.randint(8, 80))))
-        await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
+        if env.engine and trial % 2:
+            # a snap_in snapshot 1 .. 4 clocks after the read that applies the write: the edges
+            # around that read tell where the new EDGE starts
+            while not [r for r in reads if r + 1 >= switch]:
+                await RisingEdge(dut.clk)
+            await ClockCycles(dut.clk, rng.randint(0, 3))
+            await FallingEdge(dut.clk)
+            dut.snap_in.value = 1
+            await FallingEdge(dut.clk)
+            dut.snap_in.value = 0
+        else:
+            # (mostly soon after the change: the edges near it tell where the new EDGE starts)
+            await ClockCycles(dut.clk, rng.choice((1, 1, 2, 3, 4, 6, rng.randint(8, 80))))
+            await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
         await env.settle(8)
         snap = await read_snapshot(bus)
         t = walker.unwrap(snap["time"])
         what = f"trial {trial}, EDGE to {'a_rising' if new_a else 'any'} at timebase {switch & ts_mask:#x}, " \
             f"snapshot at {snap['time']:#x}"
         cands = {}
-        for sw in range(switch, switch + late + 1):
+        # the new EDGE chooses the edges stamped from S on; with the engine those the count takes
+        # from the clock of the read that applies the write on, stamped from that read + 1
+        switches = [r + 1 for r in reads if switch <= r + 1 <= switch + late] if env.engine else [switch]
+        assert switches, f"{what}: no read of the channel within {late} clocks of the write"
+        for sw in switches:
             m = _last_chosen(line, t, sw, new_a, a_now, floor)
             if m is not None:
                 cands[(m.t + line.EDGE_PIPE) & ts_mask] = m
@@ -236,7 +263,7 @@ async def edge_change_chooses_later_edges(dut):
             await env.settle(8)
             before = await read_snapshot(bus)
             a_now = not a_now
-            ctrl = pack("SNAP_CTRL", EDGE="a_rising" if a_now else "any")
+            ctrl = pack("SNAP_CTRL", EDGE="a_rising" if a_now else "any", IN_EN=1)
             await bus.wr("SNAP_CTRL", ctrl)
             await env.applied()
             await bus.wr("SNAP_CTRL", ctrl | pack("SNAP_CTRL", CMD=1))
@@ -248,6 +275,8 @@ async def edge_change_chooses_later_edges(dut):
             prev = None
     assert checked >= 16, f"only {checked} of 24 snapshots judged"
     trace.task.cancel()
+    if env.engine:
+        watcher.cancel()
     await bus.wr("SNAP_CTRL", 0)
 
 
