@@ -92,8 +92,16 @@ class QeiBus:
             (res,) = await self.m.send_cycle([WBOp(adr=offset, dat=data & 0xFFFFFFFF, sel=strb)])
             return res.ack == 2
         lanes = [i for i in range(4) if strb >> i & 1]
-        assert lanes and lanes == list(range(lanes[0], lanes[-1] + 1)), \
-            "AXI4-Lite master writes contiguous byte lanes only"
+        if not lanes or lanes != list(range(lanes[0], lanes[-1] + 1)):
+            # the master writes contiguous lanes only: this one (no lane, or lanes with a gap)
+            # goes straight onto its AW, W and B channels (their random back-pressure included)
+            wif = self.m.write_if
+            aw, w = wif.aw_channel._transaction_obj(), wif.w_channel._transaction_obj()
+            aw.awaddr, aw.awprot = offset, 0
+            w.wdata, w.wstrb = data & 0xFFFFFFFF, strb
+            await wif.aw_channel.send(aw)
+            await wif.w_channel.send(w)
+            return int((await wif.b_channel.recv()).bresp) != 0
         data_bytes = (data & 0xFFFFFFFF).to_bytes(4, "little")[lanes[0]:lanes[-1] + 1]
         resp = await self.m.write(offset + lanes[0], data_bytes)
         return int(resp.resp) != 0
