@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: Apache-2.0
-// Formal wrapper for enc_qei_lane's count (read by formal/enc_qei_lane.sby, tasks count and
-// count_ch16; `make formal`): the lane's low bits of the count, its range ends and stops, its
-// compare, and the count the engine rebuilds from them, against a reference count written from
-// the RDL (rtl/enc_qei.rdl: CTRL.RANGE's modes, EVENTS.OVERFLOW / UNDERFLOW / CMP,
-// STATUS.STOPPED, CTRL.CMP_EN, COUNT and the index preset).
+// Formal wrapper for enc_qei_lane's count (read by formal/enc_qei_lane_count.sby; `make
+// formal`): the lane's low bits of the count, its range ends and stops, its compare, and the
+// count the engine rebuilds from them, against a reference count written from the RDL
+// (rtl/enc_qei.rdl: CTRL.RANGE's modes, EVENTS.OVERFLOW / UNDERFLOW / CMP, STATUS.STOPPED,
+// CTRL.CMP_EN, COUNT and the index preset).
 //
 // The wrapper plays the engine towards one lane (RANGE 1), with the engine's widths for CHANNELS
-// and COUNT_W 16: it reads the lane every L clocks (L free in 2 .. P; the engine reads every P:
-// formal/enc_qei_engine.sby), and pushes a configuration in the clock before each read with a
-// CEILING, COMPARE, PRESET, CTRL.RANGE and CTRL.CMP_EN chosen freely (the other fields free
+// and COUNT_W CW (16; 8 and 9: the engine's SMALL counts, CW <= MOT_W, whose free range it pushes
+// as the modulo range with CEILING all ones, as the lane also starts): it reads the lane every L
+// clocks (L free in 2 .. P; the engine reads every P: formal/enc_qei_engine.sby), and pushes a
+// configuration in the clock before each read with a CEILING, COMPARE, PRESET, CTRL.RANGE and
+// CTRL.CMP_EN chosen freely (the other fields free
 // too). A COUNT write of any value comes as the engine makes it: its value pushed in the clock
 // before (push #1: the configuration as it was, with C_PLO and C_VS_LOAD the value's), then the
 // push with ld, which loads it; the configuration does not change with it (a COUNT write is the
@@ -19,7 +21,7 @@
 // COMPARE. Free at every clock: rst (the first clock is a reset), valid, the pins, the index, probe_in;
 // PROBE_CTRL.EN and INDEX_CTRL.ARM written at any push.
 //
-// The reference (CW = 16 bits) steps with the lane's decode (step_up / step_dn, the per-channel
+// The reference (CW bits) steps with the lane's decode (step_up / step_dn, the per-channel
 // core's own enc_qei_decode) in the configuration in force: free wraps modulo 2^CW; modulo wraps
 // up from CEILING or above to 0, down from 0 to CEILING; limit drops a step at those ends;
 // non_recycle stops there (and counts nothing until a COUNT write); an up step at the end raises
@@ -46,7 +48,8 @@
 `include "enc_qei_lane_w.vh"
 
 module enc_qei_lane_count_formal #(
-    parameter integer CHANNELS = 2  // the engine's channels: P and the widths from them
+    parameter integer CHANNELS = 2,  // the engine's channels: P and the widths from them
+    parameter integer CW       = 16  // COUNT_W (8 .. 16: 8 and 9 are the engine's SMALL counts)
 ) (
     input wire clk,
     input wire rst,
@@ -66,8 +69,11 @@ module enc_qei_lane_count_formal #(
   `include "enc_qei_regs.vh"
   `include "enc_qei_lane.vh"
 
-  localparam integer CW = 16;  // COUNT_W
   localparam [63:0] SZ      = (64'd1 << CW) - 64'd1;
+  // The engine's SMALL count (COUNT_W <= MOT_W): the free range is pushed as the modulo range
+  // with CEILING all ones (enc_qei_engine's lane_ceil), so the lane takes its wraps as anchors;
+  // with COUNT_W < MOT_W the lane also compares lo with CEILING as it is (its WHOLE).
+  localparam integer SMALLF = (CW <= MOT_W) ? 1 : 0;
   localparam [63:0] REACH64 = REACH;
   localparam [CW-1:0] TOP   = {CW{1'b1}};
 
@@ -109,6 +115,7 @@ module enc_qei_lane_count_formal #(
   reg [1:0]    f_rg;            // CTRL.RANGE
   reg          f_cen;           // CTRL.CMP_EN
   reg [CW-1:0] f_c0, f_pr0;     // CEILING and PRESET before the last push (the engine's until the read)
+  reg [1:0]    f_rg0;           // ... and CTRL.RANGE
   reg [CW-1:0] f_val;           // the COUNT write's value (push #1 .. its load)
 
   // a push: the new configuration (unchanged with a COUNT write's load)
@@ -118,12 +125,44 @@ module enc_qei_lane_count_formal #(
   wire [1:0]    n_rg  = ld ? f_rg : range_in;
   wire          n_cen = ld ? f_cen : cmpen_in;
 
+  function [63:0] x64;  // a count, zero-extended
+    input [CW-1:0] x;
+    begin
+      x64 = 64'd0;
+      x64[CW-1:0] = x;
+    end
+  endfunction
+
+  function [MOT_W-1:0] lowb;  // a count's low MOT_W bits (zero-extended when narrower)
+    input [CW-1:0] x;
+    reg   [63:0]   t;
+    begin
+      t    = x64(x);
+      lowb = t[MOT_W-1:0];
+    end
+  endfunction
+
+  function [1:0] lrg;  // the range as the lane counts it
+    input [1:0] rg;
+    begin
+      lrg = (SMALLF != 0 && rg == ENC_QEI_RANGE_FREE) ? ENC_QEI_RANGE_MODULO : rg;
+    end
+  endfunction
+
+  function [CW-1:0] lc;  // CEILING as the lane counts it, in range rg
+    input [1:0]    rg;
+    input [CW-1:0] c;
+    begin
+      lc = (SMALLF != 0 && rg == ENC_QEI_RANGE_FREE) ? TOP : c;
+    end
+  endfunction
+
   function [3:0] vs;  // the engine's validity set of x for CEILING c and COMPARE m
     input [CW-1:0] x;
     input [CW-1:0] c;
     input [CW-1:0] m;
     begin
-      vs = lane_vs_of({48'd0, x}, {48'd0, c}, {48'd0, m}, SZ, REACH64, 1'b1);
+      vs = lane_vs_of(x64(x), x64(c), x64(m), SZ, REACH64, 1'b1);
     end
   endfunction
 
@@ -136,20 +175,21 @@ module enc_qei_lane_count_formal #(
   wire [CW-1:0] q_pr  = push1 ? val_in : n_pr;
   wire [1:0]    q_rg  = push1 ? f_rg : n_rg;
   wire          q_cen = push1 ? f_cen : n_cen;
+  wire [CW-1:0] q_cl  = lc(q_rg, q_c);  // the lane's CEILING
   reg [CFG_W-1:0] cfg;
   always @(*) begin
     cfg = cfg_in;
-    cfg[C_RANGE +: C_RANGE_W] = q_rg;
+    cfg[C_RANGE +: C_RANGE_W] = lrg(q_rg);
     cfg[C_CMP_EN]             = q_cen;
-    cfg[C_PLO +: C_PLO_W]     = q_pr[MOT_W-1:0];
-    cfg[C_CLO +: C_CLO_W]     = q_c[MOT_W-1:0];
-    cfg[C_MLO +: C_MLO_W]     = q_m[MOT_W-1:0];
-    cfg[C_VS_CNT +: VS_W]     = vs(f_rread, q_c, q_m);
-    cfg[C_VS_LOAD +: VS_W]    = vs(q_pr, q_c, q_m);
-    cfg[C_VS_ZERO +: VS_W]    = vs({CW{1'b0}}, q_c, q_m);
-    cfg[C_VS_CEIL +: VS_W]    = vs(q_c, q_c, q_m);
-    cfg[C_VSO_LOAD +: VS_W]   = vs(f_pr, q_c, q_m);
-    cfg[C_VSO_CEIL +: VS_W]   = vs(f_c, q_c, q_m);
+    cfg[C_PLO +: C_PLO_W]     = lowb(q_pr);
+    cfg[C_CLO +: C_CLO_W]     = lowb(q_cl);
+    cfg[C_MLO +: C_MLO_W]     = lowb(q_m);
+    cfg[C_VS_CNT +: VS_W]     = vs(f_rread, q_cl, q_m);
+    cfg[C_VS_LOAD +: VS_W]    = vs(q_pr, q_cl, q_m);
+    cfg[C_VS_ZERO +: VS_W]    = vs({CW{1'b0}}, q_cl, q_m);
+    cfg[C_VS_CEIL +: VS_W]    = vs(q_cl, q_cl, q_m);
+    cfg[C_VSO_LOAD +: VS_W]   = vs(f_pr, q_cl, q_m);
+    cfg[C_VSO_CEIL +: VS_W]   = vs(lc(f_rg, f_c), q_cl, q_m);
   end
 
   // ---- the lane -----------------------------------------------------------------------------------
@@ -165,7 +205,8 @@ module enc_qei_lane_count_formal #(
       .TIMING(0),
       .RANGE (1),
       .PROBE (1),
-      .PERIOD(0)
+      .PERIOD(0),
+      .SMALL_W((SMALLF != 0) ? CW : 0)
   ) lane (
       .clk      (clk),
       .rst      (rst),
@@ -239,7 +280,9 @@ module enc_qei_lane_count_formal #(
                           (u & ~drop) ? f_r + 1'b1 : (d & ~drop) ? f_r - 1'b1 : f_r;
   wire          moved   = ld | p_preset | w0 | wc | ((u | d) & ~drop);
   wire [CW-1:0] r_n     = ld ? f_val : p_preset ? f_pr : r_st;
-  wire          anchor  = ld | p_preset | w0 | wc;
+  // an anchor of the lane's: a load, or a wrap of the range the lane counts (SMALL: the free
+  // range's too)
+  wire          anchor  = ld | p_preset | w0 | wc | ((SMALLF != 0) & r_free & (e_up | e_dn));
 
   always @(posedge clk) begin
     if (rst) begin
@@ -264,6 +307,7 @@ module enc_qei_lane_count_formal #(
       f_cen  <= 1'b0;
       f_c0   <= TOP;
       f_pr0  <= {CW{1'b0}};
+      f_rg0  <= ENC_QEI_RANGE_FREE;
       f_val  <= {CW{1'b0}};
       f_rread <= {CW{1'b0}};
     end else begin
@@ -276,6 +320,7 @@ module enc_qei_lane_count_formal #(
         f_cen <= n_cen;
         f_c0  <= f_c;
         f_pr0 <= f_pr;
+        f_rg0 <= f_rg;
       end
       if (rd) f_rread <= f_r;
     end
@@ -329,41 +374,43 @@ module enc_qei_lane_count_formal #(
   // visit after the read)
   wire [CW-1:0] e_pre  = f_ld ? f_val : (rd ? f_pr0 : f_pr);
   wire [CW-1:0] e_ceil = rd ? f_c0 : f_c;
-  wire [63:0]   e_cnt  = lane_rebuild(p_lo, p_anc, {48'd0, e_pre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
+  wire [63:0]   e_cnt  = lane_rebuild(p_lo, p_anc, x64(e_pre), x64(e_ceil), x64(f_rread), SZ);
+  // (the value of an A_CEIL anchor: the lane's CEILING)
+  wire [CW-1:0] e_ceil_l = rd ? lc(f_rg0, f_c0) : lc(f_rg, f_c);
 
   // ... and a latch as the engine rebuilds it (its anchor is never a COUNT write's load: that
   // comes in the push's clock, after which the read starts a new window)
   wire [CW-1:0] e_lpre = rd ? f_pr0 : f_pr;
-  wire [63:0]   e_lat  = lane_rebuild(p_lcap, p_lanc, {48'd0, e_lpre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
-  wire [63:0]   e_plat = lane_rebuild(p_plo, p_panc, {48'd0, e_lpre}, {48'd0, e_ceil}, {48'd0, f_rread}, SZ);
+  wire [63:0]   e_lat  = lane_rebuild(p_lcap, p_lanc, x64(e_lpre), x64(e_ceil), x64(f_rread), SZ);
+  wire [63:0]   e_plat = lane_rebuild(p_plo, p_panc, x64(e_lpre), x64(e_ceil), x64(f_rread), SZ);
 
   // ---- the properties -----------------------------------------------------------------------------
   always @(*) begin
     if (f_past && !rst) begin
       assert (el_q >= 10'd1 && el_q <= P && cd_q < P && {1'b0, cd_q} + {1'b0, el_q} <= P);
       // the count, its ends, its stop, its compare
-      assert (p_lo == f_r[MOT_W-1:0]);
+      assert (p_lo == lowb(f_r));
       assert (p_up_end == e_up && p_dn_end == e_dn);
       assert (p_stop == f_s);
       assert (cmp_out == f_cmp_q);
       // stored + pending = the true count
       assert (e_cnt[CW-1:0] == f_r);
       // a latch waiting to be read: the count at its edge
-      if (p_lpend) assert (e_lat[CW-1:0] == f_lat && p_lcap == f_lat[MOT_W-1:0]);
-      if (p_ppend) assert (e_plat[CW-1:0] == f_plat && p_plo == f_plat[MOT_W-1:0]);
+      if (p_lpend) assert (e_lat[CW-1:0] == f_lat && p_lcap == lowb(f_lat));
+      if (p_ppend) assert (e_plat[CW-1:0] == f_plat && p_plo == lowb(f_plat));
       // helpers
-      assert (p_vset == vs(f_base, f_c, f_m));
+      assert (p_vset == vs(f_base, lc(f_rg, f_c), f_m));
       assert (f_dist <= P + el_q && wdist(f_r, f_base) <= {6'd0, f_dist});
       assert (wdist(f_r, f_rread) <= {6'd0, el_q} || p_anc != A_NONE[1:0]);
-      assert (p_cfg[C_RANGE +: C_RANGE_W] == f_rg && p_cfg[C_CMP_EN] == f_cen &&
-              p_cfg[C_CLO +: C_CLO_W] == f_c[MOT_W-1:0] && p_cfg[C_MLO +: C_MLO_W] == f_m[MOT_W-1:0] &&
-              p_cfg[C_PLO +: C_PLO_W] == (p1_q ? f_val[MOT_W-1:0] : f_pr[MOT_W-1:0]));
-      assert (p_cfg[C_VS_LOAD +: VS_W] == vs(p1_q ? f_val : f_pr, f_c, f_m) &&
-              p_cfg[C_VS_ZERO +: VS_W] == vs({CW{1'b0}}, f_c, f_m) &&
-              p_cfg[C_VS_CEIL +: VS_W] == vs(f_c, f_c, f_m));
+      assert (p_cfg[C_RANGE +: C_RANGE_W] == lrg(f_rg) && p_cfg[C_CMP_EN] == f_cen &&
+              p_cfg[C_CLO +: C_CLO_W] == lowb(lc(f_rg, f_c)) && p_cfg[C_MLO +: C_MLO_W] == lowb(f_m) &&
+              p_cfg[C_PLO +: C_PLO_W] == lowb(p1_q ? f_val : f_pr));
+      assert (p_cfg[C_VS_LOAD +: VS_W] == vs(p1_q ? f_val : f_pr, lc(f_rg, f_c), f_m) &&
+              p_cfg[C_VS_ZERO +: VS_W] == vs({CW{1'b0}}, lc(f_rg, f_c), f_m) &&
+              p_cfg[C_VS_CEIL +: VS_W] == vs(lc(f_rg, f_c), lc(f_rg, f_c), f_m));
       if (p_anc != A_NONE[1:0]) assert (f_dist < el_q);
       if (p_anc == A_ZERO[1:0]) assert (f_base == {CW{1'b0}} && !f_ld);
-      if (p_anc == A_CEIL[1:0]) assert (f_base == e_ceil && !f_ld);
+      if (p_anc == A_CEIL[1:0]) assert (f_base == e_ceil_l && !f_ld);
       if (p_anc == A_LOAD[1:0]) assert (f_base == e_pre);
       if (p_anc == A_LOAD[1:0] && f_ld) assert (rd);  // a COUNT write's load: the push before the read
       assert (p_upd == f_mv_q);

@@ -159,7 +159,8 @@ module enc_qei_engine #(
           .RANGE (RANGE),
           .PROBE (PROBE),
           .PERIOD(PERIOD),
-          .EFIFO (EFIFO)
+          .EFIFO (EFIFO),
+          .SMALL_W((SMALL != 0) ? COUNT_W : 0)
       ) u_lane (
           .clk      (clk),
           .rst      (rst),

@@ -56,8 +56,12 @@ module enc_qei_lane #(
     parameter integer RANGE  = 0,  // 1: ranges and compare
     parameter integer PROBE  = 0,  // 1: the probe latch
     parameter integer PERIOD = 0,  // 1: period capture, stall detection and the unit timer
-    parameter integer EFIFO  = 0   // 1: the channel has an edge FIFO (beside the engine): its steps
+    parameter integer EFIFO  = 0,  // 1: the channel has an edge FIFO (beside the engine): its steps
                                    // out, its events in
+    parameter integer SMALL_W = 0  // COUNT_W when the engine counts it SMALL (COUNT_W <= MOT_W: the
+                                   // free range pushed as modulo with CEILING all ones, from
+                                   // reset on), else 0; below MOT_W lo holds the whole count and
+                                   // is compared with CEILING as it is
 ) (
     input  wire             clk,
     input  wire             rst,        // synchronous, active high
@@ -117,6 +121,10 @@ module enc_qei_lane #(
   // from 0 modulo 2^COUNT_W: each is at the end of the range, at CEILING and at COMPARE
   localparam [3:0] VS_RST_0 = 4'b1011;  // 0
   localparam [3:0] VS_RST_C = 4'b1011;  // CEILING
+  // a SMALL count below MOT_W bits: lo is the whole count (see ge_c), CEILING's reset value is
+  // 2^COUNT_W - 1
+  localparam         WHOLE = (SMALL_W != 0 && SMALL_W < MOT_W);
+  localparam [MOT_W-1:0] C_RST = WHOLE ? {MOT_W{1'b1}} >> (MOT_W - SMALL_W) : {MOT_W{1'b1}};
   reg  [CFG_W-1:0] cfg_q;
   wire [CFG_W-1:0] cfg_rst;
 
@@ -127,7 +135,10 @@ module enc_qei_lane #(
   assign cfg_rst[C_INV_Z]              = ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_INV_Z];
   assign cfg_rst[C_FUNC +: C_FUNC_W]   = ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_FUNC +: C_FUNC_W];
   assign cfg_rst[C_LAST +: C_LAST_W]   = FILT_RST[3:0] - 4'd1;  // (the reset FILTER_LEN is in 1 .. 16)
-  assign cfg_rst[C_RANGE +: C_RANGE_W] = ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_RANGE +: C_RANGE_W];
+  // (a SMALL count: the free range as the engine pushes it, modulo with CEILING 2^COUNT_W - 1)
+  assign cfg_rst[C_RANGE +: C_RANGE_W] = (SMALL_W != 0 &&
+                                          ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_RANGE +: C_RANGE_W] == ENC_QEI_RANGE_FREE) ?
+                                         ENC_QEI_RANGE_MODULO : ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_RANGE +: C_RANGE_W];
   assign cfg_rst[C_CMP_EN]             = ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_CMP_EN];
   assign cfg_rst[C_ACT +: C_ACT_W]     = ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ACTION +: C_ACT_W];
   assign cfg_rst[C_ONESHOT]            = ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ONESHOT];
@@ -149,7 +160,7 @@ module enc_qei_lane #(
   assign cfg_rst[C_UPER +: C_UPER_W]   = {{(TIM_W-1){1'b0}}, 1'b1};  // SNAP_PERIOD 0 acts as 1
   assign cfg_rst[C_UD +: C_UD_W]       = {TIM_W{1'b0}};
   assign cfg_rst[C_PLO +: C_PLO_W]     = {MOT_W{1'b0}};  // PRESET 0
-  assign cfg_rst[C_CLO +: C_CLO_W]     = {MOT_W{1'b1}};  // CEILING all ones
+  assign cfg_rst[C_CLO +: C_CLO_W]     = C_RST;           // CEILING all ones
   assign cfg_rst[C_MLO +: C_MLO_W]     = {MOT_W{1'b0}};  // COMPARE 0
   assign cfg_rst[C_VS_CNT +: VS_W]     = VS_RST_0;
   assign cfg_rst[C_VS_LOAD +: VS_W]    = VS_RST_0;
@@ -299,9 +310,13 @@ module enc_qei_lane #(
   // sides of it (a count that crossed it since the set was made): lo's top bit tells the side
   // (set: just below 2^COUNT_W), and CEILING's low bits' top bit CEILING's when it is in reach too
   // (V_C, modulo 2^COUNT_W); a CEILING out of reach lies between the two sides.
+  // With a SMALL count below MOT_W bits the count is all in lo (it never leaves 0 ..
+  // 2^COUNT_W - 1, half of lo's range at most), so lo >= CEILING is the sign of their difference;
+  // lo's top bit is then no side.
   wire             lo_hi  = lo_q[MOT_W-1];
   wire             c_hi   = c_lo[MOT_W-1];
-  wire             ge_c   = (vset[V_B] & vset[V_C] & (lo_hi != c_hi)) ? lo_hi :
+  wire             ge_c   = WHOLE ? ~dc[MOT_W-1] :
+                            (vset[V_B] & vset[V_C] & (lo_hi != c_hi)) ? lo_hi :
                             vset[V_C] ? ~dc[MOT_W-1] :
                             vset[V_B] ? lo_hi : vset[V_AC];
   wire             u_step = step_up & ~stop_q;
