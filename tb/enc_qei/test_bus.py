@@ -520,7 +520,8 @@ async def wb_abandoned_request(dut):
     flip = 0xFF0000 if wide else 0xF0
     for gap in (1, 2):
         for hold in (1, 2):
-            v = (0x3C5A_0000 if wide else 0x5000) | gap << 8 | hold
+            v = (0x3C5A_0000 | gap << 8 if wide else 0x5000 | gap << 8 if env.count_w >= 16
+                 else 0x50 | gap << 2) | hold
             # (what, abandoned request, new request: (we, adr, data), the new one's answer: (err,
             # data read), the registers written by either, to read back afterwards)
             cases = (

@@ -127,7 +127,8 @@ async def index_gate_same_position(dut):
     bus = env.bus
     model = QeiModel(env.count_w)
     await env.setup(model, count=0)
-    await bus.set64("PRESET", 500)
+    preset = 500 & model.max  # (COUNT_W 8: 0xF4)
+    await bus.set64("PRESET", preset)
     gate = QUAD[6 % 4]
     await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", GATE_EN=1, GATE_A=gate[0],
                                     GATE_B=gate[1], ARM=1))
@@ -139,8 +140,8 @@ async def index_gate_same_position(dut):
         wf = walk(steps, durations(rng, len(steps)), start_pos=env.pos)
         await env.play(wf, None, zfun=zf)
         got = await bus.count()
-        # the count equals 500 at position 6, whichever way it was crossed
-        assert got == 500 + (target - 6), f"direction {direction}: count {got}"
+        # the count equals PRESET at position 6, whichever way it was crossed
+        assert got == (preset + target - 6) & model.max, f"direction {direction}: count {got}"
 
 
 @cocotb_test(skip=lacks("PROBE"))
@@ -379,7 +380,7 @@ async def ctrl_change_is_not_an_index_edge(dut):
         await bus.wr("INDEX_CTRL", 0)
         dut.z_in.value = z
         await bus.wr("CTRL", ctrl(option, v0))
-        count = 0x100 + 0x10 * k
+        count = (0x100 + 0x10 * k) & model.max
         await bus.set_count(count)
         await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION=action, EDGE=edge, ARM=1,
                                         GATE_EN=int(gate is not None), GATE_A=gate[0] if gate else 0,
@@ -397,7 +398,7 @@ async def ctrl_change_is_not_an_index_edge(dut):
         assert got == held, f"{what}: the CTRL write changed INDEX_LATCH to {got:#x} (was {held:#x})"
         # a real Z edge right after: a pulse of Z makes one edge of the armed type (with the gate
         # and the falling edge, back into the gate first: no edge either)
-        count2 = count + 5
+        count2 = (count + 5) & model.max
         await bus.set_count(count2)
         if gate is not None and edge == "falling":
             await bus.wr("CTRL", ctrl(option, v0))
@@ -453,7 +454,7 @@ async def gate_change_is_an_index_edge(dut):
         for edge in ("rising", "falling"):
             for arm in (1, 0):
                 what = f"gate {g0} -> {g1} ({made} edge), EDGE {edge}, ARM {arm} in the write"
-                count = 0x100 + 0x20 * k
+                count = (0x100 + 0x20 * k) & model.max
                 await bus.wr("INDEX_CTRL", index_ctrl(g0, edge, 0))
                 await bus.set_count(count)
                 await env.applied()

@@ -162,7 +162,7 @@ async def steps_at_patterned_ceilings(dut):
     cases = []
     for i in range(12):
         mode = ("modulo", "limit", "non_recycle")[i % 3]
-        sl = pick.randrange(0, env.count_w // 16)
+        sl = pick.randrange(0, max(1, env.count_w // 16))
         ceiling = pick.getrandbits(env.count_w) >> pick.randrange(0, env.count_w)
         cases.append((mode, ceiling, (-1, 1, 2, -(1 << 16 * sl), 1 << 16 * sl, 5 << 16 * sl, -(5 << 16 * sl))))
     for ceiling in WIDE + tuple(~v for v in WIDE):
@@ -300,7 +300,7 @@ async def ceiling_slice_compares(dut):
 # profile leaves out; the full and lean builds run it)
 @cocotb_test(skip=lacks("RANGE", "TIMING"))
 async def range_change_across_the_wrap(dut):
-    """CTRL.RANGE written from free to limit or modulo (CEILING 1000) while the count crosses the
+    """CTRL.RANGE written from free to limit or modulo (CEILING 1000, COUNT_W 8: 127) while the count crosses the
     end of the free range: from 2 four steps down and two up, or from all ones - 1 six steps up,
     3 clocks apart, starting i clocks after the CTRL write starts. With the shared engine every
     write starts at one phase of its visits and i runs over 2 P + 24 clocks, so the new range is
@@ -312,7 +312,7 @@ async def range_change_across_the_wrap(dut):
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
-    ceiling = 1000
+    ceiling = min(1000, model.max // 2)  # (COUNT_W 8: 127)
     cases = (("limit", 2, (-1, -1, -1, -1, 1, 1)), ("modulo", 2, (-1, -1, -1, -1, 1, 1)),
              ("limit", -2, (1,) * 6), ("modulo", -2, (1,) * 6))
     clock = Timebase(dut)

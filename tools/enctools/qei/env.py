@@ -121,6 +121,8 @@ CONFIGS = (("enc_qei_wb", 32, 32, "full", 0), ("enc_qei_axil", 64, 16, "full", 0
            ("enc_qei_wb", 32, 32, "lean", 1),
            # a count narrower than a register (COUNT_W 16): both architectures
            ("enc_qei_wb", 16, 32, "full", 0), ("enc_qei_wb", 16, 32, "full", 1),
+           # the narrowest count (COUNT_W 8: the engine's lane holds all of it)
+           ("enc_qei_wb", 8, 32, "full", 0), ("enc_qei_wb", 8, 32, "full", 1),
            # the counting profile (no timing unit: CAPS.TIMING 0): both architectures
            ("enc_qei_wb", 32, 32, "counting", 0), ("enc_qei_wb", 32, 32, "counting", 1))
 
