@@ -168,6 +168,24 @@ async def _white_box(dut):
     return env, rng, 1 << int(dut.EFIFO_LOG2.value), efifo
 
 
+async def _step_now(env):
+    """One step forward, its pins changed at the next falling clock edge (no settling)."""
+    await FallingEdge(env.dut.clk)
+    env.pos += 1
+    env.dut.a_in.value, env.dut.b_in.value = QUAD[env.pos % 4]
+
+
+async def _one_step(env):
+    """One step forward, its state held 3 clocks, then settled."""
+    await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+
+
+async def _fill(env, depth: int):
+    """Steps until the FIFO holds ``depth`` entries (EFIFO_STATUS.LEVEL)."""
+    while await env.bus.rd("EFIFO_STATUS") & 0x1FF < depth:
+        await _one_step(env)
+
+
 @cocotb_test()
 async def entries_match_the_walk(dut):
     """A random walk (reversals at any state) read back in full: every step in order with its
@@ -641,15 +659,9 @@ async def full_fifo_pop_in_the_push_clock(dut):
     await env.applied()
 
     async def prepare():
-        while await bus.rd("EFIFO_STATUS") & 0x1FF < depth:  # full again
-            await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
+        await _fill(env, depth)  # full again
         await bus.wr("EFIFO_LOST", 0)
         await env.settle()
-
-    async def step():
-        await FallingEdge(dut.clk)
-        env.pos += 1
-        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
 
     async def judge(d, word):
         await env.settle()
@@ -661,7 +673,8 @@ async def full_fifo_pop_in_the_push_clock(dut):
             f"a full FIFO, the step's entry written {d:+d} clocks from the pop: EFIFO_LOST {lost}"
 
     got = await aimed_races(dut, lambda: int(efifo.pop.value), lambda: int(efifo.push_q.value),
-                            prepare, step, lambda: bus.rd("EFIFO_ENTRY"), judge, lead=-4)
+                            prepare, lambda: _step_now(env), lambda: bus.rd("EFIFO_ENTRY"), judge,
+                            lead=-4)
     dut._log.info("pushes at these clocks from the pop: %s", got)
     await bus.wr("EFIFO_CTRL", 0)
 
@@ -692,14 +705,6 @@ async def ctrl_and_lost_write_clocks(dut):
     def stepped():
         return int(efifo.step_up.value) | int(efifo.step_dn.value)
 
-    async def one_step():
-        await env.play(walk([1], [3 * T_NS], start_pos=env.pos), None)
-
-    async def step():
-        await FallingEdge(dut.clk)
-        env.pos += 1
-        dut.a_in.value, dut.b_in.value = QUAD[env.pos % 4]
-
     async def race(what, prepare, access, outcome, first):
         """Steps aimed at s = r + first - 3 .. r + first + 3: ``outcome(s - r)`` after each must
         be 1 iff s >= r + first (aimed_races's d is s - (r + first): its reference is the clock
@@ -721,7 +726,8 @@ async def ctrl_and_lost_write_clocks(dut):
             assert got == int(d >= 0), \
                 f"{what}: a step at s = r{first + d:+d}: {got}, expected {int(d >= 0)}"
 
-        got = await aimed_races(dut, boundary, stepped, arm, step, access, judge, lead=-4 - first)
+        got = await aimed_races(dut, boundary, stepped, arm, lambda: _step_now(env), access, judge,
+                                lead=-4 - first)
         dut._log.info("%s: steps at s = r + %s", what, [first + d for d in got])
 
     def ctrl(en, clear=0):
@@ -747,8 +753,7 @@ async def ctrl_and_lost_write_clocks(dut):
     # iff s <= r (the one with s = r + 1 is dropped by the clear, no loss)
     async def full():
         await emptied(1)
-        while await level() < depth:
-            await one_step()
+        await _fill(env, depth)
 
     async def cleared(s):
         n, lost = await level(), await bus.rd("EFIFO_LOST")
@@ -764,10 +769,9 @@ async def ctrl_and_lost_write_clocks(dut):
     # EFIFO_LOST: a full FIFO, two steps lost before; the step's loss stays counted iff s >= r
     async def full_and_lost():
         await bus.wr("EFIFO_CTRL", pack("EFIFO_CTRL", EN=1))
-        while await level() < depth:
-            await one_step()
-        await one_step()
-        await one_step()
+        await _fill(env, depth)
+        await _one_step(env)
+        await _one_step(env)
         await env.settle()
         assert await bus.rd("EFIFO_LOST") >= 2
 

@@ -17,7 +17,7 @@ from hedsmodel import QUAD, random_walk, walk
 from enctools.qei.env import (CONFIG_IDS, CONFIGS, ENGINE_SHOW, begin, engine_period, lacks,
                               run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations, pulse_rst
+from enctools.qei.stimulus import durations, illegal_jumps, pulse_rst
 from enctools.regmap import built_mask, field, pack, regmap, units
 from enctools.tb import cocotb_test
 
@@ -172,7 +172,7 @@ async def irq_low_in_reset(dut):
     bus = env.bus
     await bus.wr("IRQ_EN", 0xFFF)
     if lacks("TIMING"):  # (the counting profile: an illegal jump, QERR pending)
-        await env.play(walk([2], [45.0], start_pos=env.pos), None)
+        await illegal_jumps(env, 1)
     else:
         await bus.wr("SNAP_CTRL", pack("SNAP_CTRL", CMD=1))  # SNAP_READY pending
     await env.settle(20)

@@ -23,7 +23,7 @@ from enctools.qei.bus import AXIL_SNAP_LAT, PERIOD_PS, T_NS, WB_SNAP_LAT, BusTra
 from enctools.qei.env import (CONFIG_IDS, CONFIGS, ClockTrace, Timebase, begin, build_param,
                               engine_build, engine_period, lacks, read_snapshot, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import ClockWalk, Mark, Timeline, durations
+from enctools.qei.stimulus import ClockWalk, Timeline, durations
 from enctools.regmap import event_bits, pack
 from enctools.tb import cocotb_test
 
@@ -158,20 +158,6 @@ async def snapshot_values_exact(dut):
     dut._log.info("snapshots checked: %s", seen)
 
 
-def _last_chosen(line: Timeline, t: int, switch: int, new_a: bool, old_a: bool, floor: int) -> Mark | None:
-    """The last edge a snapshot at timebase t holds when SNAP_CTRL.EDGE chose edges whose
-    timestamp (SNAP_EDGE_TIME) is ``switch`` or later by the new type (A rising: new_a) and
-    earlier ones by the old type; None when that edge would be older than ``floor``."""
-    for i in range(line._last(t), 0, -1):
-        m = line.marks[i]
-        e = m.t + line.EDGE_PIPE
-        if e < floor:
-            return None
-        if m.a_rise if (new_a if e >= switch else old_a) else m.step:
-            return m
-    return None
-
-
 @cocotb_test(skip=lacks("TIMING"))
 async def edge_change_chooses_later_edges(dut):
     """SNAP_CTRL.EDGE changed (any <-> A rising, no CMD) while the shaft moves clock by clock
@@ -181,8 +167,9 @@ async def edge_change_chooses_later_edges(dut):
     snapshot's edge to it. On the per-channel build the new EDGE chooses exactly the edges whose
     timestamp is the write's snapshot clock's timebase or later; with the shared engine, the edges
     the count takes from the clock of the channel's read that applies the write on (channel 0's
-    reads watched, white box; half the snapshots then by snap_in just after that read). With the shaft at rest, a change moves nothing: a
-    snapshot after it holds the same SNAP_EDGE_TIME with SNAP_EDGE_DELTA and SNAP_DELTA 0."""
+    reads watched, white box; half the snapshots then by snap_in just after that read). With the
+    shaft at rest, a change moves nothing: a snapshot after it holds the same SNAP_EDGE_TIME with
+    SNAP_EDGE_DELTA and SNAP_DELTA 0."""
     env, rng = await begin(dut)
     bus = env.bus
     model = QeiModel(env.count_w)
@@ -240,7 +227,7 @@ async def edge_change_chooses_later_edges(dut):
         switches = [r + 1 for r in reads if switch <= r + 1 <= switch + late] if env.engine else [switch]
         assert switches, f"{what}: no read of the channel within {late} clocks of the write"
         for sw in switches:
-            m = _last_chosen(line, t, sw, new_a, a_now, floor)
+            m = line.edge(t, new_a, switch=sw, old_a=a_now, floor=floor)
             if m is not None:
                 cands[(m.t + line.EDGE_PIPE) & ts_mask] = m
         if cands:  # (else the last chosen edge is older than the walk so far: not judged)

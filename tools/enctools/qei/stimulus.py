@@ -224,11 +224,18 @@ class Timeline:
         """The last mark a snapshot at (unwrapped) timebase t holds."""
         return self.marks[self._last(t)]
 
-    def edge(self, t: int, a_rising: bool) -> Mark | None:
-        """The last selected edge (SNAP_CTRL.EDGE) a snapshot at timebase t holds."""
+    def edge(self, t: int, a_rising: bool, switch: int | None = None, old_a: bool = False,
+             floor: int | None = None) -> Mark | None:
+        """The last selected edge (SNAP_CTRL.EDGE: A rising edges if ``a_rising``, else every step)
+        a snapshot at timebase t holds. With ``switch`` (an EDGE change), the edges stamped
+        (SNAP_EDGE_TIME) before it were chosen by ``old_a`` instead. None when there is none, or
+        when it would be stamped before ``floor``."""
         for i in range(self._last(t), 0, -1):
             m = self.marks[i]
-            if m.a_rise if a_rising else m.step:
+            e = m.t + self.EDGE_PIPE
+            if floor is not None and e < floor:
+                return None
+            if m.a_rise if (a_rising if switch is None or e >= switch else old_a) else m.step:
                 return m
         return None
 
@@ -261,6 +268,13 @@ class ClockWalk:
         self.last_tb = int(self.tb.value)
         self.t = self.last_tb  # the timebase unwrapped
 
+    def _overlay(self, a: int, b: int, z: int, k: int) -> tuple[int, int, int]:
+        """The pin vectors a, b, z with walk k's bit set to its state (its position's A and B, its
+        Z)."""
+        bit, (sa, sb) = self.bits[k], QUAD[self.pos[k] % 4]
+        keep = ~(1 << bit)
+        return a & keep | sa << bit, b & keep | sb << bit, z & keep | self.z[k] << bit
+
     def now(self) -> int:
         """The timebase now, unwrapped (it must be read at least once per wrap of the timebase:
         run() reads it every clock)."""
@@ -282,11 +296,7 @@ class ClockWalk:
         # the walked bits from the walk's own state: a run started in the timestep of the last
         # run's final write reads the pins before that write lands
         for k in range(n):
-            bit = self.bits[k]
-            state = QUAD[self.pos[k] % 4]
-            a = a & ~(1 << bit) | state[0] << bit
-            b = b & ~(1 << bit) | state[1] << bit
-            z = z & ~(1 << bit) | self.z[k] << bit
+            a, b, z = self._overlay(a, b, z, k)
         for _ in range(clocks):
             await FallingEdge(dut.clk)
             self.now()
@@ -301,11 +311,8 @@ class ClockWalk:
                 self.pos[k] += self.dirs[k]
                 new = QUAD[self.pos[k] % 4]
                 zk = self.zfuns[k](self.pos[k]) if self.zfuns[k] else 0
-                bit = self.bits[k]
-                a = a & ~(1 << bit) | new[0] << bit
-                b = b & ~(1 << bit) | new[1] << bit
-                z = z & ~(1 << bit) | zk << bit
                 self.z[k] = zk
+                a, b, z = self._overlay(a, b, z, k)
                 model = self.models[k]
                 model.sample(new, zk)
                 self.lines[k].add(Mark(self.t, model.count, model.delta, True,
