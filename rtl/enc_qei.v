@@ -98,7 +98,7 @@ module enc_qei #(
   localparam integer RANGE  = (PROFILE == P_FULL || PROFILE == P_CNT) ? 1 : 0;
   localparam integer PROBE  = RANGE;
   localparam integer PERIOD = (PROFILE == P_FULL) ? 1 : 0;
-  localparam integer EFIFO  = (EFIFO_LOG2 != 0) ? 1 : 0;
+  localparam integer EFIFO  = (EFIFO_LOG2 > 0) ? 1 : 0;
 
   generate
     // (the lean profile's count is a free-running 32..64-bit count)
@@ -110,7 +110,7 @@ module enc_qei #(
 `endif
     end
     // (the edge FIFO timestamps with the timing unit's timebase)
-    if (EFIFO_LOG2 != 0 && TIMING == 0) begin : g_bad_efifo_profile
+    if (EFIFO_LOG2 > 0 && TIMING == 0) begin : g_bad_efifo_profile
 `ifdef __ICARUS__
       enc_qei__parameter_EFIFO_LOG2_needs_PROFILE_full_or_lean u_stop ();
 `else

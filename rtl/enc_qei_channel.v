@@ -275,7 +275,7 @@ module enc_qei_channel #(
 
   // the edge-capture FIFO (enc_qei allows it only with the timing unit: its timebase)
   generate
-    if (EFIFO_LOG2 != 0) begin : g_efifo
+    if (EFIFO_LOG2 > 0) begin : g_efifo
       wire [TS_W-1:0] efifo_time;
 
       enc_qei_efifo #(

@@ -2,13 +2,14 @@
 """An out-of-range parameter must stop elaboration with a message naming the parameter, on the
 simulator under test (SIM=icarus: iverilog; SIM=verilator: verilator). Yosys is covered by
 test_param_guards_yosys.py. The cases come from enc_ip.core (each parameter's legal range, its
-corners and the values just outside), so a guard that always fires fails here too."""
+corners and the values just outside), so a guard that always fires fails here too. The message must
+also state the range: both ends (or every legal value) after the parameter's name."""
 
 import subprocess
 
 import pytest
 
-from enctools.core import files_for, guard_cases, include_dirs
+from enctools.core import files_for, guard_cases, include_dirs, names_param, ranges
 from enctools.paths import TOP
 from enctools.harness import sim_name
 
@@ -53,10 +54,8 @@ def elaborate(path: str, module: str, param: str | dict, value: int | None = Non
     return subprocess.run(cmd + sources, capture_output=True, text=True, timeout=120)
 
 
-def names_param(output: str, param: str) -> bool:
-    """The message names the parameter (or, through a submodule's guard, its own name for it:
-    PHASE_WINDOW_LOG2 of the board top is WINDOW_LOG2 of the phase meter)."""
-    return param in output or param.split("_", 1)[-1] in output
+# a submodule's own name for a parameter of the board top: its message may name that
+SUBMODULE_NAME = {"PHASE_WINDOW_LOG2": ("WINDOW_LOG2",)}
 
 
 @pytest.mark.parametrize("path,module,param,value,ok", CASES,
@@ -68,7 +67,10 @@ def test_parameter_guard(path, module, param, value, ok):
         assert result.returncode == 0, f"{module} {param}={value} should elaborate:\n{output}"
     else:
         assert result.returncode != 0, f"{module} {param}={value} elaborated; it must stop"
-        assert names_param(output, param), f"the message does not name {param}:\n{output}"
+        alias = SUBMODULE_NAME.get(param, ())
+        assert names_param(output, param, alias), f"the message does not name {param}:\n{output}"
+        assert ranges()[param].stated_in(output, alias), \
+            f"the message does not state {param}'s range {ranges()[param].text()}:\n{output}"
 
 
 @pytest.mark.parametrize("module,params,ok,name", RELATIONAL,
@@ -81,4 +83,4 @@ def test_relational_guard(module, params, ok, name):
         assert result.returncode == 0, f"{module} {params} should elaborate:\n{output}"
     else:
         assert result.returncode != 0, f"{module} {params} elaborated; it must stop"
-        assert name in output, f"the message does not name {name}:\n{output}"
+        assert names_param(output, name), f"the message does not name {name}:\n{output}"

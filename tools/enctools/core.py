@@ -87,6 +87,34 @@ class ParamRange:
     def text(self) -> str:
         return ", ".join(map(str, self.values)) if self.values else f"{self.lo} .. {self.hi}"
 
+    def stated_in(self, output: str, names: tuple[str, ...] = ()) -> bool:
+        """A guard's message states this range: some line of ``output`` names the parameter (or
+        one of ``names``, a submodule's own name for it; see ``names_param``) and, after the name,
+        both ends of the range (every value of a list) as numbers of their own. Verilator's echo
+        of the source line (`` 40 |     if (X < 1 || X > 16) ...``) is not a message and does
+        not count."""
+        for line in output.splitlines():
+            if re.match(r"\s*[0-9]*\s*\|", line):
+                continue
+            for name in (self.name, *names):
+                for m in _name_re(name).finditer(line):
+                    numbers = set(re.findall(r"(?<![0-9])-?[0-9]+(?![0-9])", line[m.end():]))
+                    if {str(v) for v in self.corners} <= numbers:
+                        return True
+        return False
+
+
+def _name_re(name: str) -> re.Pattern:
+    # the name as a word of its own: not the tail of another name (MAX_FILTER_LEN is not
+    # FILTER_LEN), except after "parameter_" (Icarus's enc__parameter_FILTER_LEN_must_be_1_to_16)
+    return re.compile(rf"(?:(?<![A-Za-z0-9_])|(?<=parameter_)){re.escape(name)}(?![A-Za-z0-9])")
+
+
+def names_param(output: str, name: str, names: tuple[str, ...] = ()) -> bool:
+    """Some line of a guard's ``output`` names the parameter ``name`` (or one of ``names``, a
+    submodule's own name for it) as a word of its own, not inside a longer name."""
+    return any(_name_re(n).search(output) for n in (name, *names))
+
 
 @lru_cache(maxsize=None)
 def ranges() -> dict[str, ParamRange]:
