@@ -3,7 +3,9 @@
 elaborated netlist of every module in enc_ip.core (and the board):
   - one module per file, the file named after it, `default_nettype none` (C1/C2);
   - every flip-flop on the rising edge of clk, none with an asynchronous set/reset (`rst` is
-    synchronous), and no latch (C3/C4).
+    synchronous), and no latch (C3/C4);
+  - enc_updown_buffer built as Figure 17 builds it: conditioner -> 2X XOR decoder -> DIGITS ls168
+    stages, ripple carry out to the next stage's ENT, digit 0 the low nibble of count (U1).
 A module that used `always @(negedge clk)` or `always @(posedge clk or posedge rst)` fails here."""
 
 from __future__ import annotations
@@ -66,3 +68,76 @@ def test_rising_edge_synchronous_flip_flops(path):
     assert not bad, f"{module}: storage that is not a synchronous flip-flop: {bad}"
     neg = [n for n, c in storage.items() if int(str(c["parameters"].get("CLK_POLARITY", "1")), 2) != 1]
     assert not neg, f"{module}: flip-flops on the falling clock edge: {neg}"
+
+
+def _netlist(module: str, params: dict) -> dict:
+    """Yosys's netlist of ``module`` with its hierarchy kept (proc, opt_clean), as JSON."""
+    rel_out = Path("build") / "structure" / (module + "".join(f"-{k}{v}" for k, v in params.items())
+                                             + ".json")
+    (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
+    chparam = " ".join(f"-chparam {k} {v}" for k, v in params.items())
+    script = (f"{yosys_read(files_for(f'rtl/{module}.v'))}; hierarchy -check -top {module} {chparam}; "
+              f"proc; opt_clean; write_json {rel_out}")
+    r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, f"{module}: yosys failed:\n{r.stdout[-2000:]}{r.stderr[-2000:]}"
+    return json.loads((TOP / rel_out).read_text())["modules"][module]
+
+
+def buffer_structure(top: dict, digits: int) -> list[str]:
+    """What in ``top`` (enc_updown_buffer's netlist) differs from Figure 17's chain; [] if none."""
+    cells = top["cells"]
+    port = {k: v["bits"] for k, v in top["ports"].items()}
+    of = lambda kind: [c["connections"] for c in cells.values()  # noqa: E731
+                       if re.fullmatch(rf"(\$paramod\\)?{kind}(\\.*)?", c["type"])]
+    # the inverted nets: Y bit -> A bit of each $not
+    inv = {c["connections"]["Y"][0]: c["connections"]["A"][0]
+           for c in cells.values() if c["type"] == "$not"}
+    bad = []
+    cond, x2, stages = of("enc_conditioner"), of("enc_x2_xor"), of("ls168")
+    if len(cond) != 1 or len(x2) != 1:
+        return [f"{len(cond)} enc_conditioner and {len(x2)} enc_x2_xor cells, not one each"]
+    cond, x2 = cond[0], x2[0]
+    if (cond["a_in"], cond["b_in"]) != (port["a_in"], port["b_in"]):
+        bad.append("the conditioner does not take a_in, b_in")
+    if (x2["a"], x2["b"]) != (cond["a"], cond["b"]):
+        bad.append("the 2X decoder does not take the conditioner's a, b")
+    if len(stages) != digits:
+        return bad + [f"{len(stages)} ls168 stages, not DIGITS = {digits}"]
+    by_digit = {}
+    for st in stages:
+        for k in range(digits):
+            if st["q"] == port["count"][4 * k:4 * k + 4]:
+                by_digit[k] = st
+    if sorted(by_digit) != list(range(digits)):
+        return bad + [f"the stages' q are not count's nibbles, digit 0 the lowest: {sorted(by_digit)}"]
+    pulse = x2["cnt_pulse"][0]
+    for k, st in by_digit.items():
+        carry_in = inv.get(st["ent_n"][0]) == pulse if k == 0 else st["ent_n"] == by_digit[k - 1]["rco_n"]
+        if not carry_in:
+            bad.append(f"digit {k}: ENT_n is not " + ("~cnt_pulse" if k == 0 else f"digit {k - 1}'s RCO_n"))
+        if inv.get(st["enp_n"][0]) != pulse:
+            bad.append(f"digit {k}: ENP_n is not ~cnt_pulse")
+        if st["up"] != x2["up"]:
+            bad.append(f"digit {k}: U/D is not the decoder's up")
+    if port["rco_n"] != by_digit[digits - 1]["rco_n"]:
+        bad.append("rco_n is not the last stage's RCO_n")
+    return bad
+
+
+@pytest.mark.parametrize("digits", [1, 3, 8])
+def test_updown_buffer_structure(digits):
+    """Figure 17's chain, on the elaborated netlist (hierarchy kept): one conditioner on a_in / b_in
+    feeding one enc_x2_xor, DIGITS ls168 stages with q = count[4k+3:4k], stage 0's ENT_n and every
+    stage's ENP_n the inverted count pulse, each stage's ENT_n the previous stage's RCO_n, U/D the
+    decoder's up, and the buffer's rco_n the last stage's."""
+    top = _netlist("enc_updown_buffer", {"DIGITS": digits})
+    assert buffer_structure(top, digits) == []
+    # the check can fail: two stages' carries swapped, the chain reversed
+    if digits > 1:
+        broken = json.loads(json.dumps(top))
+        stages = sorted((c for c in broken["cells"].values() if "ls168" in c["type"]),
+                        key=lambda c: c["connections"]["q"])
+        a, b = stages[0]["connections"], stages[1]["connections"]
+        a["ent_n"], b["ent_n"] = b["ent_n"], a["ent_n"]
+        assert buffer_structure(broken, digits), "a swapped carry chain passes"
