@@ -18,7 +18,7 @@ import random
 
 import cocotb
 import numpy as np
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from cocotb.utils import get_sim_time
 
 from enctools import tb as tbutil
@@ -236,6 +236,66 @@ async def hedsmodel_units(dut):
         # the model's own measurement of the same waveform (all of its cycles, local period):
         # same state-width extreme within a few clocks' worth of degrees
         assert abs(results[0][1]["state_min"] / DEG - m.min_state_deg) <= 3 * 360.0 / 200 + 1.0
+
+
+@cocotb_test()
+async def reset_clears_outputs(dut):
+    """One clock of rst: in the next clock every output is 0 (the results, state_min, pass and
+    valid), whether a result was held, a window was being measured or its conversion was running;
+    a conversion cut by rst lands no result, and the first window after rst measures only cycles
+    after it (its result is a fresh window's, checked against the references)."""
+    rng = random.Random(log_seed(dut))
+    await start_clock(dut)
+    n = window_cycles(dut)
+    ch, cpc = Channels(70.0, 12.0, -9.0), 203.9
+    period_ns = cpc * CLK_PS / 1000.0
+    valids = []
+
+    async def count_valid():
+        while True:
+            await RisingEdge(dut.clk)
+            await ReadOnly()
+            if int(dut.valid.value):
+                valids.append(get_sim_time("ps"))
+
+    async def one_reset_clock(what):
+        await FallingEdge(dut.clk)
+        dut.rst.value = 1
+        await RisingEdge(dut.clk)
+        await FallingEdge(dut.clk)
+        dut.rst.value = 0
+        await ReadOnly()  # (the clock after the one rst clock)
+        got = {k: int(getattr(dut, k).value) for k in OUTPUTS + ("pass", "valid")}
+        assert not any(got.values()), f"{what}: outputs after one clock of rst: {got}"
+        await FallingEdge(dut.clk)
+
+    watch = cocotb.start_soon(count_valid())
+    held = await run_unit(dut, ch, cpc, True, "before the resets")
+    assert held["phase_err"] and held["state_min"] and held["pass"] == 1, held
+    await one_reset_clock("a result held")
+    for where in ("measuring", "converting"):
+        # a new window, cut by rst part way through its measurement or in its conversion
+        wf = waveform(ch, [((n + 3) * period_ns, 1 / period_ns)], theta0=-30.0)
+        play_task = cocotb.start_soon(play(dut, off_grid(wf, get_sim_time("ps"), CLK_PS), "a", "b"))
+        if where == "measuring":
+            await Timer(int(rng.uniform(0.3, 0.8) * n * period_ns), unit="ns")
+        else:
+            while not int(dut.conv_q.value):  # (white box: the conversion's run flag)
+                await RisingEdge(dut.clk)
+            await ClockCycles(dut.clk, rng.randint(0, 20))
+        before = len(valids)
+        await one_reset_clock(f"rst while {where}")
+        await play_task
+        await ClockCycles(dut.clk, 1000)  # (a conversion takes about 300)
+        assert len(valids) == before, f"rst while {where}: a result landed after it"
+    # a full window after rst: one result, a fresh window's
+    results, start_ps = await characterize(dut, waveform(ch, [((n + 3) * period_ns, 1 / period_ns)],
+                                                         theta0=-30.0))
+    assert len(results) == 1, f"{len(results)} results after the resets"
+    exact, cont = expected(waveform(ch, [((n + 3) * period_ns, 1 / period_ns)], theta0=-30.0),
+                           start_ps, n)
+    check(dut, results[0][1], exact, cont, "the first window after rst", CLK_PS / 1000.0)
+    watch.cancel()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -200,6 +200,50 @@ async def reset_mid_motion(dut):
 
 
 @cocotb_test()
+async def one_reset_clock_clears_every_output(dut):
+    """One clock of rst, at random points of a fast walk (states at 1.2 to 2.4 times the
+    contract's limit) and at every clock around a rejected one-sample pulse: in the clock after it
+    count and rd_data are 0, error and glitch 0, and rco_n high (no count wraps); the rejected
+    pulse counts nothing. (reset_mid_motion checks the counting after a reset.)"""
+    buf = await start(dut)
+    rng = random.Random(cocotb.RANDOM_SEED + 7)
+
+    async def reset_clock(what):
+        await FallingEdge(dut.clk)
+        dut.rst.value = 1
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        got = {k: int(getattr(dut, k).value) for k in ("count", "rd_data", "error", "glitch", "rco_n")}
+        assert got == {"count": 0, "rd_data": 0, "error": 0, "glitch": 0, "rco_n": 1}, \
+            f"{what}: outputs in the clock after one rst clock: {got}"
+        await FallingEdge(dut.clk)
+        dut.rst.value = 0
+
+    s_min, s_max = state_range_ns(buf)
+    pos = 0
+    for trial in range(6):
+        wf = random_walk(rng, 200, s_min, s_max, start_pos=pos)
+        task = cocotb.start_soon(play(dut, wf, clock_period_ps=PERIOD_PS))
+        await Timer(int(rng.uniform(0.2, 0.8) * wf.events[-1][0]), unit="ns")
+        await reset_clock(f"walk {trial}")
+        await task
+        await buf.settle()
+        pos = wf.final_position
+    # around a rejected pulse (FILTER_LEN > 1; at 1 the pulse is two steps): the reset on each
+    # clock from the pulse to the rejection and after
+    for d in range(buf.f + 3 if buf.f > 1 else 0):
+        await FallingEdge(dut.clk)
+        dut.a_in.value = 1 - int(dut.a_in.value)
+        await FallingEdge(dut.clk)
+        dut.a_in.value = 1 - int(dut.a_in.value)
+        for _ in range(d):
+            await FallingEdge(dut.clk)
+        await reset_clock(f"a one-sample pulse, reset {d} clocks after it")
+        await buf.settle()
+        assert buf.count() == 0 and int(dut.glitch.value) == 0
+
+
+@cocotb_test()
 async def illegal_jumps_flagged(dut):
     """Both channels flipping at the same instant (an illegal transition, two states at once):
     every jump that moves A pulses `error`, so the count is never wrong silently."""
