@@ -5,7 +5,8 @@ elaborated netlist of every module in enc_ip.core (and the board):
   - every flip-flop on the rising edge of clk, none with an asynchronous set/reset (`rst` is
     synchronous), and no latch (C3/C4);
   - enc_updown_buffer built as Figure 17 builds it: conditioner -> 2X XOR decoder -> DIGITS ls168
-    stages, ripple carry out to the next stage's ENT, digit 0 the low nibble of count (U1).
+    stages, ripple carry out to the next stage's ENT, digit 0 the low nibble of count (U1);
+  - the decoders' outputs registered: no combinational path from an input port to an output (C9).
 A module that used `always @(negedge clk)` or `always @(posedge clk or posedge rst)` fails here."""
 
 from __future__ import annotations
@@ -141,3 +142,59 @@ def test_updown_buffer_structure(digits):
         a, b = stages[0]["connections"], stages[1]["connections"]
         a["ent_n"], b["ent_n"] = b["ent_n"], a["ent_n"]
         assert buffer_structure(broken, digits), "a swapped carry chain passes"
+
+
+DECODERS = ["enc_x4_decoder", "enc_x2_xor", "enc_x1_hysteresis"]
+
+
+def comb_inputs(module: dict, bit) -> set:
+    """The input-port bits from which a combinational path (no flip-flop on the way) reaches
+    net ``bit`` of a flattened netlist."""
+    inputs = {b: name for name, p in module["ports"].items() if p["direction"] == "input"
+              for b in p["bits"]}
+    driver = {}  # net bit -> the input bits of the combinational cell driving it
+    for c in module["cells"].values():
+        if re.search(r"(dff|latch|\$sr$|\$mem)", c["type"]):
+            continue  # storage: a path through it is registered
+        dirs = c.get("port_directions", {})
+        ins = [b for p, bits in c["connections"].items() if dirs.get(p) == "input" for b in bits]
+        for p, bits in c["connections"].items():
+            if dirs.get(p) == "output":
+                for b in bits:
+                    driver[b] = ins
+    seen, todo, found = set(), [bit], set()
+    while todo:
+        b = todo.pop()
+        if b in seen or isinstance(b, str):  # (a constant)
+            continue
+        seen.add(b)
+        if b in inputs:
+            found.add(inputs[b])
+        todo += driver.get(b, [])
+    return found
+
+
+@pytest.mark.parametrize("module", DECODERS)
+def test_decoder_outputs_registered(module):
+    """The decoders' outputs are registered (C9): no output bit has a combinational path from an
+    input port (clk drives only flip-flops; rst is synchronous)."""
+    path = f"rtl/{module}.v"
+    rel_out = Path("build") / "structure" / f"{module}-flat.json"
+    (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
+    script = (f"{yosys_read(files_for(path))}; hierarchy -check -top {module}; proc; flatten; "
+              f"opt_clean; write_json {rel_out}")
+    r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, f"{module}: yosys failed:\n{r.stdout[-2000:]}{r.stderr[-2000:]}"
+    top = json.loads((TOP / rel_out).read_text())["modules"][module]
+    outputs = [(name, b) for name, p in top["ports"].items() if p["direction"] == "output"
+               for b in p["bits"]]
+    assert outputs, f"{module}: no outputs"
+    paths = {name: sorted(comb_inputs(top, b)) for name, b in outputs if comb_inputs(top, b)}
+    assert not paths, f"{module}: outputs with a combinational path from inputs: {paths}"
+    # the check can fail: an output and an input joined by a gate
+    gate = {"type": "$and", "port_directions": {"A": "input", "B": "input", "Y": "output"},
+            "connections": {"A": top["ports"]["clk"]["bits"], "B": [outputs[0][1]],
+                            "Y": [outputs[0][1]]}}
+    broken = dict(top, cells=dict(top["cells"], probe_gate=gate))
+    assert comb_inputs(broken, outputs[0][1]) == {"clk"}
