@@ -10,7 +10,7 @@ from enctools.harness import run
 
 def test_enc_x1_hysteresis():
     run("enc_x1_hysteresis", "enctools.tb.decoder_bench", name="enc_x1_hysteresis",
-        testcase=COMMON_TESTS + ",x1_hysteresis_bound,reset_then_illegal_jump")
+        testcase=COMMON_TESTS + ",x1_hysteresis_bound,x1_runs_after_any_history,reset_then_illegal_jump")
 
 
 def test_naive_x1_fails_hysteresis():

@@ -206,12 +206,57 @@ async def x1_hysteresis_bound(dut):
             s.hold(1)
             while s.p - start_pos != t:
                 s.move(1, 1)
-            side = 1
-            for _ in range(30):  # 30 crossings of the same edge
-                s.move(side, rng.randint(1, 3))
-                side = -side
             await play_samples(dut, s, bound=4)
+            # 30 crossings of the same edge: at most one pulse in total (X1.2), counted on the
+            # outputs of the dither alone
+            d = Samples(s.p)
+            side = 1
+            for _ in range(30):
+                d.move(side, rng.randint(1, 3))
+                side = -side
+            ups, dns = await play_samples(dut, d)
+            assert ups + dns <= 1, f"start {start_pos}, transition {t}: {ups} up and {dns} down " \
+                "pulses in 30 crossings of one transition"
     await play_samples(dut, random_walk(rng, 3000), bound=4)
+
+
+@cocotb_test()
+async def x1_runs_after_any_history(dut):
+    """A monotone run of 4m valid transitions gives m or m - 1 pulses in its direction and none in
+    the other, after any history (X1.5, counted on the run's own outputs, against the model too);
+    continuing a monotone run from reset in the same direction, exactly m. From every state, both
+    directions, m = 1, 2, 3, after random walks of 0 .. 12 transitions with reversals and after
+    monotone runs of 1 .. 9 transitions."""
+    await start(dut)
+    model = model_for(dut)
+    rng = random.Random(cocotb.RANDOM_SEED + 5)
+    for start_pos in range(4):
+        for direction in (1, -1):
+            for trial in range(12):
+                continuing = trial % 3 == 0
+                s = Samples(start_pos)
+                s.reset()
+                s.hold(1)
+                if continuing:
+                    for _ in range(rng.randint(1, 9)):
+                        s.move(direction, rng.randint(1, 2))
+                else:
+                    step = rng.choice((1, -1))
+                    for _ in range(rng.randint(0, 12)):
+                        step = -step if rng.random() < 0.4 else step
+                        s.move(step, rng.randint(1, 2))
+                await play_samples(dut, s, model)
+                m = rng.randint(1, 3)
+                run = Samples(s.p)
+                for _ in range(4 * m):
+                    run.move(direction, rng.randint(1, 2))
+                run.hold(2)
+                ups, dns = await play_samples(dut, run, model)
+                along, against = (ups, dns) if direction > 0 else (dns, ups)
+                want = {m} if continuing else {m - 1, m}
+                assert along in want and against == 0, \
+                    f"start {start_pos} dir {direction} trial {trial} ({'continuing' if continuing else 'after a walk'}): " \
+                    f"a run of {4 * m} gave {along} pulses along and {against} against; want {sorted(want)}, 0"
 
 
 @cocotb_test()
@@ -242,6 +287,7 @@ async def reset_then_illegal_jump(dut):
                 await play_samples(dut, s, model)
 
 
-# cocotb tests every decoder runs (enc_x1_hysteresis adds x1_hysteresis_bound)
+# cocotb tests every decoder runs (enc_x1_hysteresis adds x1_hysteresis_bound and
+# x1_runs_after_any_history)
 COMMON_TESTS = ("random_walk_20k,reset_mid_motion,reversal_at_every_state,dither_every_transition,"
                 "monotone_runs")
