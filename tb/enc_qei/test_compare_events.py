@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import cocotb
 import pytest
-from cocotb.triggers import ClockCycles, FallingEdge, RisingEdge, Timer
+from cocotb.simtime import get_sim_time
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 from hedsmodel import QUAD, random_walk, walk
 
 from enctools.qei.bus import PERIOD_PS, T_NS
-from enctools.qei.env import (ENGINE_SHOW, CONFIG_IDS, CONFIGS, FILTER, begin, engine_period, lacks,
-                              run_feature)
+from enctools.qei.env import (ENGINE_SHOW, CONFIG_IDS, CONFIGS, FILTER, begin, channel, engine_build,
+                              engine_period, lacks, run_feature)
 from enctools.qei.model import QeiModel
-from enctools.qei.stimulus import durations, play_clocks
+from enctools.qei.stimulus import ClockWalk, durations, play_clocks
 from enctools.regmap import event_bits, get_field, pack
 from enctools.tb import cocotb_test
 
@@ -185,6 +186,89 @@ async def events_and_irq(dut):
         if name in ("OVERFLOW",):
             model.count = 0
     assert await bus.rd("GLITCH_COUNT") >= 1
+
+
+# the core's one-clock event pulses (white box, per-channel build) by the model's event names
+CORE_EVENTS = {"OVERFLOW": "ev_overflow", "UNDERFLOW": "ev_underflow", "INDEX": "ev_index",
+               "CMP": "ev_cmp", "DIR_CHANGE": "ev_dir_change", "QERR": "ev_qerr"}
+
+
+@cocotb_test(skip=lacks("RANGE") or engine_build())
+async def events_each_clock(dut):
+    """OVERFLOW, UNDERFLOW, INDEX, CMP and DIR_CHANGE compared with the model clock by clock, not
+    per segment: a walk at the count-rate bound (FILTER_LEN 1, a state every 1 .. 3 clocks,
+    reversals) across both ends of a small modulo and then limit range, with COMPARE inside it and
+    an index preset on every pulse of Z. Every event the model raises at a pin change is one pulse
+    of the core's event (white box: the per-channel core's ev_* outputs, before EVENTS) a fixed
+    number of clocks later (fixed per event), and there is no other pulse; EVENTS then holds
+    their union."""
+    env, rng = await begin(dut)
+    bus = env.bus
+    core = channel(dut).u_core
+    pulses = {name: getattr(core, sig) for name, sig in CORE_EVENTS.items()}
+    model = QeiModel(env.count_w)  # (one model: the direction of the last step carries over)
+    for mode in ("modulo", "limit"):
+        ceiling = rng.randint(12, 40)
+        await env.setup(model, func="x4", rng_mode=mode, filter_len=1,
+                        count=rng.randint(0, ceiling), ceiling=ceiling,
+                        compare=rng.randint(1, ceiling - 1))
+        preset = rng.randint(0, ceiling)
+        await bus.set64("PRESET", preset)
+        await bus.wr("INDEX_CTRL", pack("INDEX_CTRL", ACTION="preset", EDGE="rising", ARM=1))
+        model.preset, model.idx_action, model.idx_edge, model.idx_arm = preset, "preset", "rising", True
+        await env.applied()
+        await bus.events()
+        model.take_events()
+        want, got, lags = [], [], {}  # (clock, event): the model's at each pin change, the core's pulses
+        sample = model.sample
+
+        def logged(state, z=0, sample=sample):
+            sample(state, z)
+            want.extend((int(get_sim_time("ns") // T_NS), e) for e in model.take_events())
+        model.sample = logged
+
+        async def watch():
+            while True:
+                await RisingEdge(dut.clk)
+                await ReadOnly()
+                got.extend((int(get_sim_time("ns") // T_NS), e) for e, h in pulses.items()
+                           if int(h.value))
+        watcher = cocotb.start_soon(watch())
+        rev = rng.randint(17, 40)
+        walker = ClockWalk(dut, [model], rng, positions=[env.pos], shortest=1, longest=3,
+                           p_reverse=0.25, zfuns=[lambda p, rev=rev: int(p % rev < 2)])
+        need = {"OVERFLOW", "UNDERFLOW", "INDEX", "CMP", "DIR_CHANGE"}
+        for chunk in range(12):  # (3,000 clocks, more until the walk has raised every event)
+            if chunk >= 6 and need <= {e for _, e in want}:
+                break
+            await walker.run(500)
+        await env.settle(8)
+        watcher.cancel()
+        env.pos = walker.pos[0]
+        model.sample = sample
+        kinds = {e for _, e in want}
+        assert need <= kinds, \
+            f"{mode}: the walk raised only {sorted(kinds)}"
+        for kind in sorted(kinds):
+            w = sorted(t for t, e in want if e == kind)
+            g = sorted(t for t, e in got if e == kind)
+            assert g, f"{mode}: the model raised {len(w)} {kind}, the core no pulse"
+            lag = g[0] - w[0]  # (each event its own pipeline depth)
+            lags[kind] = lag
+            assert 1 <= lag <= 8, f"{mode}: first {kind} pulse {lag} clocks after the model's"
+            extra = sorted(set(g) - {t + lag for t in w})[:6]
+            missing = sorted({t + lag for t in w} - set(g))[:6]
+            assert g == [t + lag for t in w], \
+                f"{mode}: {kind}: the core's pulses and the model's events (+{lag} clocks) " \
+                f"differ: pulses at clocks {extra} the model did not raise, events of clocks " \
+                f"{[t - lag for t in missing]} with no pulse ({len(g)} pulses, {len(w)} events)"
+        stray = {e for _, e in got} - kinds
+        assert not stray, f"{mode}: pulses of {sorted(stray)}, which the model never raised"
+        dut._log.info("%s: %d events, each a pulse this many clocks after its pin change: %s",
+                      mode, len(want), lags)
+        ev = await bus.events()
+        assert ev - {"SNAP_READY"} == kinds, f"{mode}: EVENTS {sorted(ev)}, model {sorted(kinds)}"
+        await bus.wr("INDEX_CTRL", 0)
 
 
 @cocotb_test()
