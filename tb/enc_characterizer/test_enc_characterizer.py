@@ -241,9 +241,10 @@ async def hedsmodel_units(dut):
 @cocotb_test()
 async def reset_clears_outputs(dut):
     """One clock of rst: in the next clock every output is 0 (the results, state_min, pass and
-    valid), whether a result was held, a window was being measured or its conversion was running;
-    a conversion cut by rst lands no result, and the first window after rst measures only cycles
-    after it (its result is a fresh window's, checked against the references)."""
+    valid), whether a result was held alone, or held while a window was being measured or its
+    conversion was running; a conversion cut by rst lands no result; and a window that starts
+    right after the one clock of rst (no other reset) measures only cycles after it: its result
+    is a fresh window's, checked against the references."""
     rng = random.Random(log_seed(dut))
     await start_clock(dut)
     n = window_cycles(dut)
@@ -251,12 +252,15 @@ async def reset_clears_outputs(dut):
     period_ns = cpc * CLK_PS / 1000.0
     valids = []
 
+    def unit_waveform():
+        return waveform(ch, [((n + 3) * period_ns, 1 / period_ns)], theta0=-30.0)
+
     async def count_valid():
         while True:
             await RisingEdge(dut.clk)
             await ReadOnly()
             if int(dut.valid.value):
-                valids.append(get_sim_time("ps"))
+                valids.append((get_sim_time("ps"), read_outputs(dut)))
 
     async def one_reset_clock(what):
         await FallingEdge(dut.clk)
@@ -269,14 +273,19 @@ async def reset_clears_outputs(dut):
         assert not any(got.values()), f"{what}: outputs after one clock of rst: {got}"
         await FallingEdge(dut.clk)
 
+    async def hold_a_result(what):
+        held = await run_unit(dut, ch, cpc, True, what)
+        assert held["phase_err"] and held["state_min"] and held["pass"] == 1, held
+
     watch = cocotb.start_soon(count_valid())
-    held = await run_unit(dut, ch, cpc, True, "before the resets")
-    assert held["phase_err"] and held["state_min"] and held["pass"] == 1, held
+    await hold_a_result("a result to clear")
     await one_reset_clock("a result held")
     for where in ("measuring", "converting"):
-        # a new window, cut by rst part way through its measurement or in its conversion
-        wf = waveform(ch, [((n + 3) * period_ns, 1 / period_ns)], theta0=-30.0)
-        play_task = cocotb.start_soon(play(dut, off_grid(wf, get_sim_time("ps"), CLK_PS), "a", "b"))
+        # a result held, and a new window cut by rst part way through its measurement or in its
+        # conversion
+        await hold_a_result(f"a result held while {where}")
+        play_task = cocotb.start_soon(play(dut, off_grid(unit_waveform(), get_sim_time("ps"), CLK_PS),
+                                           "a", "b"))
         if where == "measuring":
             await Timer(int(rng.uniform(0.3, 0.8) * n * period_ns), unit="ns")
         else:
@@ -288,13 +297,19 @@ async def reset_clears_outputs(dut):
         await play_task
         await ClockCycles(dut.clk, 1000)  # (a conversion takes about 300)
         assert len(valids) == before, f"rst while {where}: a result landed after it"
-    # a full window after rst: one result, a fresh window's
-    results, start_ps = await characterize(dut, waveform(ch, [((n + 3) * period_ns, 1 / period_ns)],
-                                                         theta0=-30.0))
-    assert len(results) == 1, f"{len(results)} results after the resets"
-    exact, cont = expected(waveform(ch, [((n + 3) * period_ns, 1 / period_ns)], theta0=-30.0),
-                           start_ps, n)
-    check(dut, results[0][1], exact, cont, "the first window after rst", CLK_PS / 1000.0)
+    # a full window started right after one clock of rst, the levels of the waveform's start on
+    # a and b in that clock: one result, a fresh window's
+    wf = unit_waveform()
+    _, dut.a.value, dut.b.value = wf.events[0]
+    await one_reset_clock("before a full window")
+    start_ps = get_sim_time("ps")
+    before = len(valids)
+    await play(dut, off_grid(wf, start_ps, CLK_PS), "a", "b")
+    await FallingEdge(dut.clk)
+    got = valids[before:]
+    assert len(got) == 1, f"{len(got)} results from the window after one clock of rst"
+    exact, cont = expected(wf, start_ps, n)
+    check(dut, got[0][1], exact, cont, "the first window after one clock of rst", CLK_PS / 1000.0)
     watch.cancel()
 
 

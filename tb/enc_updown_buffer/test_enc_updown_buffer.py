@@ -202,14 +202,15 @@ async def reset_mid_motion(dut):
 @cocotb_test()
 async def one_reset_clock_clears_every_output(dut):
     """One clock of rst, at random points of a fast walk (states at 1.2 to 2.4 times the
-    contract's limit) and at every clock around a rejected one-sample pulse: in the clock after it
-    count and rd_data are 0, error and glitch 0, and rco_n high (no count wraps); the rejected
-    pulse counts nothing. (reset_mid_motion checks the counting after a reset.)"""
+    contract's limit), and on each clock from a one-sample pulse's own sampling clock to past its
+    rejection: in the clock after it count and rd_data are 0, error and glitch 0, and rco_n high
+    (no count wraps); a pulse cut by the reset counts nothing and leaves no glitch pulse after
+    the reset. (reset_mid_motion checks the counting after a reset.)"""
     buf = await start(dut)
     rng = random.Random(cocotb.RANDOM_SEED + 7)
 
     async def reset_clock(what):
-        await FallingEdge(dut.clk)
+        # (called at a falling edge: rst is sampled at the next rising edge)
         dut.rst.value = 1
         await RisingEdge(dut.clk)
         await ReadOnly()
@@ -225,22 +226,30 @@ async def one_reset_clock_clears_every_output(dut):
         wf = random_walk(rng, 200, s_min, s_max, start_pos=pos)
         task = cocotb.start_soon(play(dut, wf, clock_period_ps=PERIOD_PS))
         await Timer(int(rng.uniform(0.2, 0.8) * wf.events[-1][0]), unit="ns")
+        await FallingEdge(dut.clk)
         await reset_clock(f"walk {trial}")
         await task
         await buf.settle()
         pos = wf.final_position
-    # around a rejected pulse (FILTER_LEN > 1; at 1 the pulse is two steps): the reset on each
-    # clock from the pulse to the rejection and after
-    for d in range(buf.f + 3 if buf.f > 1 else 0):
+    # a one-sample pulse on a_in (FILTER_LEN > 1; at 1 the pulse is two steps), sampled at a
+    # rising edge R0; rst sampled at R0 + k for k = 0 .. FILTER_LEN + 3
+    for k in range(buf.f + 4 if buf.f > 1 else 0):
         await FallingEdge(dut.clk)
-        dut.a_in.value = 1 - int(dut.a_in.value)
-        await FallingEdge(dut.clk)
-        dut.a_in.value = 1 - int(dut.a_in.value)
-        for _ in range(d):
+        dut.a_in.value = 1
+        if k == 0:
+            await reset_clock("rst with a one-sample pulse")  # (returns at the next falling edge)
+        else:
             await FallingEdge(dut.clk)
-        await reset_clock(f"a one-sample pulse, reset {d} clocks after it")
+        dut.a_in.value = 0
+        if k >= 1:
+            for _ in range(k - 1):
+                await FallingEdge(dut.clk)
+            await reset_clock(f"rst {k} clocks after a one-sample pulse")
+        flags = FlagCounter(dut)
         await buf.settle()
-        assert buf.count() == 0 and int(dut.glitch.value) == 0
+        assert buf.count() == 0 and flags.glitch == 0 and flags.error == 0, \
+            f"rst {k} clocks after a one-sample pulse: count {buf.count()}, then {flags.glitch} " \
+            f"glitch and {flags.error} error pulses"
 
 
 @cocotb_test()
