@@ -37,22 +37,39 @@ def marks_gap(row: str) -> bool:
     return re.search(r"\*\*(partial )?GAP\b", row, re.I) is not None
 
 
+def problems(rows: dict[str, str], named: list[str]) -> list[str]:
+    """What is wrong between the rows and the gap list; [] when they agree."""
+    out = []
+    unknown = [i for i in named if i not in rows]
+    if unknown:
+        out.append(f"the gap list names rows that do not exist: {unknown}")
+    closed = [i for i in named if i in rows and not marks_gap(rows[i])]
+    if closed:
+        out.append(f"the gap list names rows that no longer say GAP: {closed}")
+    missing = [i for i, r in rows.items() if marks_gap(r) and i not in named]
+    if missing:
+        out.append(f"rows that say GAP but are not in the gap list: {missing}")
+    twice = sorted({i for i in named if named.count(i) > 1})
+    if twice:
+        out.append(f"the gap list names rows twice: {twice}")
+    return out
+
+
 def test_gap_list_matches_the_rows():
     rows, named = rows_and_list(PLAN.read_text())
     assert len(rows) > 100, f"{PLAN.name}: only {len(rows)} rows found (the row pattern is wrong)"
-    unknown = [i for i in named if i not in rows]
-    assert not unknown, f"the gap list names rows that do not exist: {unknown}"
-    closed = [i for i in named if not marks_gap(rows[i])]
-    assert not closed, f"the gap list names rows that no longer say GAP: {closed}"
-    missing = [i for i, r in rows.items() if marks_gap(r) and i not in named]
-    assert not missing, f"rows that say GAP but are not in the gap list: {missing}"
-    twice = sorted({i for i in named if named.count(i) > 1})
-    assert not twice, f"the gap list names rows twice: {twice}"
+    assert problems(rows, named) == []
 
 
 def test_the_check_can_fail():
-    """The check on a made-up plan: a closed gap left in the list, and a gap missing from it."""
-    plan = ("| A1 | x | **Partial GAP:** y | z |\n| A2 | x | all | z |\n" * 1 +
-            f"\n{LIST}\n\n- **A2** closed\n")
+    """The check on a made-up plan: a closed gap left in the list, a gap missing from it, a row
+    that does not exist and one named twice."""
+    plan = ("| A1 | x | **Partial GAP:** y | z |\n| A2 | x | all | z |\n| A3 | x | **GAP** | z |\n"
+            f"\n{LIST}\n\n- **A2** closed\n- **A3, A9** open\n- **A3** again\n")
     rows, named = rows_and_list(plan)
-    assert named == ["A2"] and not marks_gap(rows["A2"]) and marks_gap(rows["A1"])
+    assert named == ["A2", "A3", "A9", "A3"]
+    found = problems(rows, named)
+    assert any("do not exist: ['A9']" in p for p in found), found
+    assert any("no longer say GAP: ['A2']" in p for p in found), found
+    assert any("not in the gap list: ['A1']" in p for p in found), found
+    assert any("twice: ['A3']" in p for p in found), found

@@ -106,13 +106,15 @@ class ParamRange:
 
 def _name_re(name: str) -> re.Pattern:
     # the name as a word of its own: not the tail of another name (MAX_FILTER_LEN is not
-    # FILTER_LEN), except after "parameter_" (Icarus's enc__parameter_FILTER_LEN_must_be_1_to_16)
+    # FILTER_LEN), except after "parameter_", and followed by anything but a letter or digit (an
+    # underscore too: Icarus's message is the module name enc__parameter_FILTER_LEN_must_be_1_to_16)
     return re.compile(rf"(?:(?<![A-Za-z0-9_])|(?<=parameter_)){re.escape(name)}(?![A-Za-z0-9])")
 
 
 def names_param(output: str, name: str, names: tuple[str, ...] = ()) -> bool:
     """Some line of a guard's ``output`` names the parameter ``name`` (or one of ``names``, a
-    submodule's own name for it) as a word of its own, not inside a longer name."""
+    submodule's own name for it) as a word of its own: not the tail of a longer name, and
+    followed by anything but a letter or digit (see ``_name_re``)."""
     return any(_name_re(n).search(output) for n in (name, *names))
 
 
