@@ -200,13 +200,14 @@ async def events_each_clock(dut):
     reversals) across both ends of a small modulo and then limit range, with COMPARE inside it and
     an index preset on every pulse of Z. Every event the model raises at a pin change is one pulse
     of the core's event (white box: the per-channel core's ev_* outputs, before EVENTS) a fixed
-    number of clocks later (fixed per event), and there is no other pulse; EVENTS then holds
-    their union."""
+    number of clocks later (fixed per event, the same in both ranges), and there is no other
+    pulse; EVENTS then holds their union."""
     env, rng = await begin(dut)
     bus = env.bus
     core = channel(dut).u_core
     pulses = {name: getattr(core, sig) for name, sig in CORE_EVENTS.items()}
     model = QeiModel(env.count_w)  # (one model: the direction of the last step carries over)
+    lags = {}  # event -> clocks from the pin change to its pulse
     for mode in ("modulo", "limit"):
         ceiling = rng.randint(12, 40)
         await env.setup(model, func="x4", rng_mode=mode, filter_len=1,
@@ -219,7 +220,7 @@ async def events_each_clock(dut):
         await env.applied()
         await bus.events()
         model.take_events()
-        want, got, lags = [], [], {}  # (clock, event): the model's at each pin change, the core's pulses
+        want, got = [], []  # (clock, event): the model's at each pin change, the core's pulses
         sample = model.sample
 
         def logged(state, z=0, sample=sample):
@@ -234,7 +235,9 @@ async def events_each_clock(dut):
                 got.extend((int(get_sim_time("ns") // T_NS), e) for e, h in pulses.items()
                            if int(h.value))
         watcher = cocotb.start_soon(watch())
-        rev = rng.randint(17, 40)
+        # (a turn longer than twice the range: between two index presets the count can reach
+        # either end from any PRESET)
+        rev = rng.randint(2 * ceiling + 8, 2 * ceiling + 30)
         walker = ClockWalk(dut, [model], rng, positions=[env.pos], shortest=1, longest=3,
                            p_reverse=0.25, zfuns=[lambda p, rev=rev: int(p % rev < 2)])
         need = {"OVERFLOW", "UNDERFLOW", "INDEX", "CMP", "DIR_CHANGE"}
@@ -253,9 +256,10 @@ async def events_each_clock(dut):
             w = sorted(t for t, e in want if e == kind)
             g = sorted(t for t, e in got if e == kind)
             assert g, f"{mode}: the model raised {len(w)} {kind}, the core no pulse"
-            lag = g[0] - w[0]  # (each event its own pipeline depth)
-            lags[kind] = lag
+            lag = g[0] - w[0]  # (each event its own pipeline depth, the same in both ranges)
             assert 1 <= lag <= 8, f"{mode}: first {kind} pulse {lag} clocks after the model's"
+            assert lags.setdefault(kind, lag) == lag, \
+                f"{mode}: {kind} pulses {lag} clocks after the pin change, {lags[kind]} in modulo"
             extra = sorted(set(g) - {t + lag for t in w})[:6]
             missing = sorted({t + lag for t in w} - set(g))[:6]
             assert g == [t + lag for t in w], \

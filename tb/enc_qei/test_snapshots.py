@@ -259,8 +259,8 @@ async def edge_change_chooses_later_edges(dut):
             assert (after["edge_time"], after["edge_delta"], after["delta"]) == (before["edge_time"], 0, 0), \
                 f"trial {trial}: EDGE changed at rest: SNAP_EDGE_TIME {before['edge_time']:#x} -> " \
                 f"{after['edge_time']:#x}, SNAP_EDGE_DELTA {after['edge_delta']:#x}, SNAP_DELTA {after['delta']:#x}"
-            # the edges before this change were chosen by the type before it, which is neither
-            # the next trial's old type nor its new one: the next search stops here
+            # the edges before this change were chosen by the type before it, which is the next
+            # trial's new type, and its search would take them for its old type's: it stops here
             prev, floor = None, walker.now()
     assert checked >= 16, f"only {checked} of 24 snapshots judged"
     trace.task.cancel()
