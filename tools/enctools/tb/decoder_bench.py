@@ -255,9 +255,10 @@ async def x1_runs_after_any_history(dut):
                 ups, dns = await play_samples(dut, run, model)
                 along, against = (ups, dns) if direction > 0 else (dns, ups)
                 want = {m} if continuing else {m - 1, m}
+                what = "continuing" if continuing else "after a walk"
                 assert along in want and against == 0, \
-                    f"start {start_pos} dir {direction} trial {trial} ({'continuing' if continuing else 'after a walk'}): " \
-                    f"a run of {4 * m} gave {along} pulses along and {against} against; want {sorted(want)}, 0"
+                    f"start {start_pos} dir {direction} trial {trial} ({what}): a run of {4 * m} " \
+                    f"gave {along} pulses along and {against} against; want {sorted(want)}, 0"
 
 
 @cocotb_test()
