@@ -26,6 +26,7 @@ from enctools.harness import run
 from enctools.tb.phase_models import (CLK_PS, DEG, Channels, characterizer_expect, cycles_of, figure3_degrees,
                           off_grid, sample_index, waveform)
 from cocotbext.quadrature import play
+from hedsmodel.waveform import Waveform
 from enctools.tb import cocotb_test, log_seed
 
 OUTPUTS = ("cycle_err", "pulse_err", "phase_err", "state_err", "state_min")
@@ -191,6 +192,47 @@ async def reversal_abandons_window(dut):
     exact = characterizer_expect(cycles_of(samples, levels, i_rev)[:n])
     cont = figure3_degrees(cycles_of([t for t, _, _ in ev], levels, i_rev)[:n])
     check(dut, results[0][1], exact, cont, "after reversal", CLK_PS / 1000.0)
+
+
+@cocotb_test()
+async def double_transition_and_stall_abandon_window(dut):
+    """In mid-window, a double transition (A falling and B changing between two samples) or a
+    stalled state (2^CNT_W + 50 clocks, past the 2^CNT_W - 1 that abandon) gives no result for
+    that window: the one result lands a whole window after the disturbance and describes the
+    cycles from the first rising edge of A after it, checked against the references."""
+    await start_clock(dut)
+    n = window_cycles(dut)
+    cpc = 211.7
+    period_ns = cpc * CLK_PS / 1000.0
+    ch = Channels(85.0, 5.0, -5.0)
+    stall_ns = (2 ** int(dut.CNT_W.value) + 50) * CLK_PS / 1000.0
+    for kind in ("double transition", "stall"):
+        wf0 = waveform(ch, [((2 * n + 6) * period_ns, 1 / period_ns)], theta0=-30.0)
+        ev, pos = wf0.events, wf0.positions
+        # mid-window: an event whose next one is a falling edge of A
+        i = next(k for k in range(len(ev) - 1) if ev[k][0] > n * period_ns / 2
+                 and ev[k][1] == ev[k - 1][1] and (ev[k + 1][1], ev[k][1]) == (0, 1))
+        wf = Waveform()
+        for k, ((t, a, b), p) in enumerate(zip(ev, pos)):
+            if kind == "double transition" and k == i:
+                continue  # (event i's change lands together with event i + 1's)
+            if kind == "double transition" and k == i + 1:
+                t = ev[i][0]
+            if kind == "stall" and k >= i:
+                t += stall_ns
+            wf.append(t, p, (a, b))
+        at = i  # the index, in wf, of the disturbance's own event
+        results, start_ps = await characterize(dut, wf)
+        assert len(results) == 1, f"{kind}: {len(results)} results"
+        t_at = wf.events[at][0]
+        assert results[0][0] > start_ps + (t_at + n * period_ns * 0.98) * 1000, \
+            f"{kind}: a result {(results[0][0] - start_ps) / 1000 - t_at:.0f} ns after it"
+        oev = off_grid(wf, start_ps).events
+        levels = [(a, b) for _, a, b in oev]
+        samples = [sample_index(t, start_ps) for t, _, _ in oev]
+        exact = characterizer_expect(cycles_of(samples, levels, at)[:n])
+        cont = figure3_degrees(cycles_of([t for t, _, _ in oev], levels, at)[:n])
+        check(dut, results[0][1], exact, cont, f"after a {kind}", CLK_PS / 1000.0)
 
 
 @cocotb_test()
