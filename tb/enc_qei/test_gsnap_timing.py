@@ -177,14 +177,17 @@ async def new_period_after_the_one_in_progress(dut):
     await ClockCycles(dut.clk, 2 * p1 + 5)
     p_cur, seen = p1, {}
     aims = [*range(-2, 12), *(rng.randint(12, p1 - 20) for _ in range(4))]
-    # AXI4-Lite back-pressure moves a write by a few clocks: aim at the boundary until both of
-    # its sides were hit (at most 30 more writes)
-    boundary = [rng.randint(-1, 2) for _ in range(30)]
+    # AXI4-Lite back-pressure moves a write by a few clocks, by amounts that can repeat with the
+    # phase of the timer: aim at the boundary until both of its sides were hit (at most 60 more
+    # writes), moving the aim after each write: later when it landed past the end of the period
+    # (d is then most of a period) or at d < PERIOD_LAG, earlier when at d >= PERIOD_LAG
+    extra, b_aim = 60, PERIOD_LAG
     while aims:
         aim = aims.pop(0)
         if not aims and not (PERIOD_LAG - 1 in seen.get(False, ()) and
-                             PERIOD_LAG in seen.get(True, ())) and boundary:
-            aims.append(boundary.pop())
+                             PERIOD_LAG in seen.get(True, ())) and extra:
+            extra -= 1
+            aims.append(b_aim)
         p_new = p2 if p_cur == p1 else p1
         nxt = trace.snapshots(0)[-1] + p_cur
         while nxt - aim - lat - 2 <= trace.now():
@@ -201,6 +204,9 @@ async def new_period_after_the_one_in_progress(dut):
         d = ends[0] - wsnap
         gaps = [b - a for a, b in zip(ends, ends[1:])][:2]
         seen.setdefault(d >= PERIOD_LAG, set()).add(d)
+        if extra < 60:  # (a boundary write)
+            late = d > p_cur // 2  # (landed after the end: d counts to the next one)
+            b_aim += 1 if late or d < PERIOD_LAG else -1
         assert ends[0] - prev == p_cur, f"d {d}: the period in progress lasted {ends[0] - prev}, not {p_cur}"
         expect = [p_new, p_new] if d >= PERIOD_LAG else [p_cur, p_new]
         assert gaps == expect, f"d {d}: periods {gaps} after the write, expected {expect}"
