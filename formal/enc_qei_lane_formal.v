@@ -28,6 +28,8 @@
 // last selected edge at or before its clock. With three
 // bits less of MOT_W or two of ERR_W (the wrapper's MOT_CUT / ERR_CUT, deliberate breaks) it
 // fails; with two and one it passes (MOT_W is sized for the reach of lo, not for the motion).
+// With the define EDGES (task edges): which transitions are selected edges, which index and probe
+// edges qualify, and ARM / PROBE_CTRL.EN, against a reference from the pins (section at the end).
 // Not here: the lane's count (lo) and its ranges, compare and latches against enc_qei_core (see
 // formal/README.md: that comparison did not finish within the time a task may take).
 `default_nettype none
@@ -371,6 +373,128 @@ module enc_qei_lane_formal #(
     // record
     if (f_past && f_rst1 && !rst) assert ((p_rec_d & ~REC_CAP) == REC_RST);
   end
+
+`ifdef EDGES
+  // ---- which edges count (task edges): the decode's edges, index and probe from the pins -------
+  // A reference written from the RDL (CTRL, INDEX_CTRL, PROBE_CTRL, SNAP_CTRL.EDGE and its
+  // edge_type_e) and the decode's stages (rtl/enc_qei_decode.v's header, the same stages
+  // formal/enc_qei_core.sby proves for the per-channel core), fed from the conditioned levels the
+  // lane's filters give (their own proof: formal/enc_conditioner_rt.sby) and the configuration in
+  // force (the lane's cfg_q, which takes every push):
+  //   sample s (clock t)  A, B after SWAP_AB / INV_A / INV_B, Z after INV_Z; the decoders held in
+  //                       reset while rst, !valid, or {FUNC, SWAP_AB, INV_A, INV_B} differs from
+  //                       the clock before (cleared by rst); the first sample after it is the
+  //                       reference. A valid transition: exactly one of A, B changed.
+  //   clock t + 2         the count takes it (edge_any, edge_a_rise) and the qualified index's
+  //                       edge: Z AND, with GATE_EN, (A, B) = (GATE_A, GATE_B); its EDGE; held in
+  //                       reset by rst | !valid; none in a clock whose {SWAP_AB, INV_A, INV_B,
+  //                       INV_Z} differs from the clock before (re-referenced, not an edge); a
+  //                       gate change is an edge like any other
+  //   clock t + 3         a selected edge (sel_q): every valid transition (any) or only those
+  //                       where A rose (a_rising), by SNAP_CTRL.EDGE in force at t + 2
+  // An armed index (ARM, ACTION not none) presets or latches at its hit; ONESHOT clears ARM
+  // after acting; a push with arm_we sets ARM as written (after what the clock did). The probe:
+  // PROBE_CTRL.EDGE of the conditioned probe_in, a hit one clock after the sample while EN (held
+  // in reset by rst | !valid); ONCE clears EN after it; a push with pen_we sets EN as written.
+  (* keep *) wire             p_ac, p_bc, p_zc, p_prc;  // lane.a_c, b_c, z_c, g_probe.probe_c
+  (* keep *) wire [CFG_W-1:0] p_cfg;                    // lane.cfg_q: the configuration in force
+  (* keep *) wire             p_arm;                    // lane.arm_q: INDEX_CTRL.ARM
+  (* keep *) wire             p_pen;                    // lane.g_probe.pen_q: PROBE_CTRL.EN
+  (* keep *) wire             p_preset, p_latch;        // lane.preset, lane.latch
+
+  localparam ARM_RST = ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM];
+  localparam PEN_RST = ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN];
+
+  wire       g_a  = (p_cfg[C_SWAP] ? p_bc : p_ac) ^ p_cfg[C_INV_A];
+  wire       g_b  = (p_cfg[C_SWAP] ? p_ac : p_bc) ^ p_cfg[C_INV_B];
+  wire       g_z  = p_zc ^ p_cfg[C_INV_Z];
+  wire [7:0] g_c  = {p_cfg[C_FUNC +: C_FUNC_W], p_cfg[C_SWAP], p_cfg[C_INV_A], p_cfg[C_INV_B],
+                     p_cfg[C_INV_Z]};
+  reg  [7:0] g_cq = 8'd0;                                 // g_c the clock before (rst: 0)
+  wire       g_drst = rst | ~valid | (g_c[7:1] != g_cq[7:1]);
+  wire       g_zref = (g_c[3:0] != g_cq[3:0]);
+  reg        g_ref = 1'b0;                                // the previous sample is a reference
+  reg  [1:0] g_prev = 2'b00;                              // ... its {A, B}
+  wire       g_tr = ~g_drst & g_ref & ((g_a ^ g_prev[1]) ^ (g_b ^ g_prev[0]));
+  wire       g_ar = g_tr & g_a & ~g_prev[1];              // ... with A rising
+  wire       g_iq = g_z & (~p_cfg[C_GATE_EN] | ((g_a == p_cfg[C_GATE_A]) &
+                                                 (g_b == p_cfg[C_GATE_B])));
+  reg        g_tr1 = 1'b0, g_ar1 = 1'b0, g_tr2 = 1'b0, g_ar2 = 1'b0, g_sel = 1'b0;
+  reg        g_iprev = 1'b0, g_iok = 1'b0, g_ih1 = 1'b0, g_ih = 1'b0;
+  reg        g_pprev = 1'b0, g_pok = 1'b0, g_ph = 1'b0;
+  reg        g_arm = 1'b0, g_pen = 1'b0;
+  wire       g_armed = g_arm & (p_cfg[C_ACT +: C_ACT_W] != ENC_QEI_INDEX_ACTION_NONE);
+
+  always @(posedge clk) begin
+    g_cq   <= rst ? 8'd0 : g_c;
+    g_ref  <= ~g_drst;
+    g_prev <= {g_a, g_b};
+    g_tr1  <= g_tr;
+    g_ar1  <= g_ar;
+    if (rst) begin
+      g_tr2 <= 1'b0;
+      g_ar2 <= 1'b0;
+      g_sel <= 1'b0;
+      g_arm <= ARM_RST;
+      g_pen <= PEN_RST;
+    end else begin
+      g_tr2 <= g_tr1;
+      g_ar2 <= g_ar1;
+      g_sel <= p_cfg[C_SEDGE] ? g_ar2 : g_tr2;
+      if (push & arm_in) g_arm <= cfg_in[C_ARM];
+      else if (g_ih & g_armed & p_cfg[C_ONESHOT]) g_arm <= 1'b0;
+      if (push & pen_in) g_pen <= cfg_in[C_PEN];
+      else if (g_ph & p_cfg[C_PONCE]) g_pen <= 1'b0;
+    end
+    if (rst | ~valid) begin
+      g_iprev <= 1'b0;
+      g_iok   <= 1'b0;
+      g_ih1   <= 1'b0;
+      g_ih    <= 1'b0;
+      g_pprev <= 1'b0;
+      g_pok   <= 1'b0;
+      g_ph    <= 1'b0;
+    end else begin
+      g_iprev <= g_iq;
+      g_iok   <= 1'b1;
+      g_ih1   <= g_iok & ~g_zref & (p_cfg[C_IEDGE] ? (g_iprev & ~g_iq) : (~g_iprev & g_iq));
+      g_ih    <= g_ih1;
+      g_pprev <= p_prc;
+      g_pok   <= 1'b1;
+      g_ph    <= g_pok & g_pen & (p_cfg[C_PEDGE] ? (g_pprev & ~p_prc) : (~g_pprev & p_prc));
+    end
+  end
+
+  // the configuration in force: a push's, from the clock after it
+  reg [CFG_W-1:0] g_pushed;
+  reg             g_was_push = 1'b0;
+  always @(posedge clk) begin
+    g_pushed   <= cfg_in;
+    g_was_push <= ~rst & (push | push1);
+  end
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      if (g_was_push) assert (p_cfg == g_pushed);
+      assert (p_sel == g_sel);                 // the selected edges (SNAP_CTRL.EDGE)
+      assert (idx_hit == g_ih);                // the qualified index edges (INDEX event)
+      assert (p_arm == g_arm && p_pen == g_pen);
+      assert (p_preset == (g_ih & g_armed &
+                           (p_cfg[C_ACT +: C_ACT_W] == ENC_QEI_INDEX_ACTION_PRESET)));
+      assert (p_latch == (g_ih & g_armed &
+                          (p_cfg[C_ACT +: C_ACT_W] == ENC_QEI_INDEX_ACTION_LATCH)));
+      assert (p_phit == g_ph);                 // the probe's latches
+    end
+  end
+
+  always @(*) begin
+    if (f_past && !rst) begin
+      cover (p_sel && p_cfg[C_SEDGE]);                          // an A-rising edge selected
+      cover (p_latch && p_cfg[C_GATE_EN] && p_cfg[C_IEDGE]);   // a gated falling index latches
+      cover (p_phit && p_cfg[C_PEDGE] && p_cfg[C_PONCE]);      // a falling probe, once
+    end
+  end
+`endif
 
 endmodule
 
