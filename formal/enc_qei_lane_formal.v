@@ -419,7 +419,8 @@ module enc_qei_lane_formal #(
   wire       g_ar = g_tr & g_a & ~g_prev[1];              // ... with A rising
   wire       g_iq = g_z & (~p_cfg[C_GATE_EN] | ((g_a == p_cfg[C_GATE_A]) &
                                                  (g_b == p_cfg[C_GATE_B])));
-  reg        g_tr1 = 1'b0, g_ar1 = 1'b0, g_tr2 = 1'b0, g_ar2 = 1'b0, g_sel = 1'b0;
+  reg  [1:0] g_e1 = 2'b00, g_e2 = 2'b00;                 // {g_tr, g_ar} one and two clocks on
+  reg        g_sel = 1'b0;
   reg        g_iprev = 1'b0, g_iok = 1'b0, g_ih1 = 1'b0, g_ih = 1'b0;
   reg        g_pprev = 1'b0, g_pok = 1'b0, g_ph = 1'b0;
   reg        g_arm = 1'b0, g_pen = 1'b0;
@@ -429,18 +430,15 @@ module enc_qei_lane_formal #(
     g_cq   <= rst ? 8'd0 : g_c;
     g_ref  <= ~g_drst;
     g_prev <= {g_a, g_b};
-    g_tr1  <= g_tr;
-    g_ar1  <= g_ar;
+    g_e1   <= {g_tr, g_ar};
     if (rst) begin
-      g_tr2 <= 1'b0;
-      g_ar2 <= 1'b0;
+      g_e2  <= 2'b00;
       g_sel <= 1'b0;
       g_arm <= ARM_RST;
       g_pen <= PEN_RST;
     end else begin
-      g_tr2 <= g_tr1;
-      g_ar2 <= g_ar1;
-      g_sel <= p_cfg[C_SEDGE] ? g_ar2 : g_tr2;
+      g_e2  <= g_e1;
+      g_sel <= p_cfg[C_SEDGE] ? g_e2[0] : g_e2[1];
       if (push & arm_in) g_arm <= cfg_in[C_ARM];
       else if (g_ih & g_armed & p_cfg[C_ONESHOT]) g_arm <= 1'b0;
       if (push & pen_in) g_pen <= cfg_in[C_PEN];
