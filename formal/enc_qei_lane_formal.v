@@ -38,7 +38,8 @@
 module enc_qei_lane_formal #(
     parameter integer CHANNELS = 2,   // the engine's channels: P and the widths from them
     parameter integer MOT_CUT  = 0,   // bits taken off MOT_W (a deliberate break)
-    parameter integer ERR_CUT  = 0    // bits taken off ERR_W (a deliberate break)
+    parameter integer ERR_CUT  = 0,   // bits taken off ERR_W (a deliberate break)
+    parameter integer PERIOD   = 0    // the lane's period capture (PERIOD_CTRL): the task edges
 ) (
     input wire clk,
     input wire rst,
@@ -108,7 +109,7 @@ module enc_qei_lane_formal #(
       .TIMING(1),
       .RANGE (1),
       .PROBE (1),
-      .PERIOD(0)
+      .PERIOD(PERIOD)
   ) lane (
       .clk      (clk),
       .rst      (rst),
@@ -368,7 +369,8 @@ module enc_qei_lane_formal #(
 
   always @(*) begin
     // the record as rst leaves it is REC_RST (rtl/enc_qei_lane.vh) but for the captures' data
-    // (REC_CAP: no reset, read only with R_SPEND / R_PPEND, which REC_RST holds at 0), whatever
+    // (REC_CAP: no reset, read only with R_SPEND, R_PPEND, R_GRST, R_NB or R_BST, and R_UARM,
+    // which REC_RST holds at 0; the task edges builds the timers and the period), whatever
     // the pins and the pushes do in that clock: the engine takes REC_RST as channel 0's first
     // record
     if (f_past && f_rst1 && !rst) assert ((p_rec_d & ~REC_CAP) == REC_RST);
@@ -392,6 +394,7 @@ module enc_qei_lane_formal #(
   //                       gate change is an edge like any other
   //   clock t + 3         a selected edge (sel_q): every valid transition (any) or only those
   //                       where A rose (a_rising), by SNAP_CTRL.EDGE in force at t + 2
+  // The same for PERIOD_CTRL.EDGE's edges (psel_q: the task builds the period capture).
   // An armed index (ARM, ACTION not none) presets or latches at its hit; ONESHOT clears ARM
   // after acting; a push with arm_we sets ARM as written (after what the clock did). The probe:
   // PROBE_CTRL.EDGE of the conditioned probe_in, a hit one clock after the sample while EN (held
@@ -401,6 +404,7 @@ module enc_qei_lane_formal #(
   (* keep *) wire             p_arm;                    // lane.arm_q: INDEX_CTRL.ARM
   (* keep *) wire             p_pen;                    // lane.g_probe.pen_q: PROBE_CTRL.EN
   (* keep *) wire             p_preset, p_latch;        // lane.preset, lane.latch
+  (* keep *) wire             p_psel;                   // lane.g_period.psel_q (PERIOD 1)
 
   localparam ARM_RST = ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM];
   localparam PEN_RST = ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN];
@@ -420,7 +424,7 @@ module enc_qei_lane_formal #(
   wire       g_iq = g_z & (~p_cfg[C_GATE_EN] | ((g_a == p_cfg[C_GATE_A]) &
                                                  (g_b == p_cfg[C_GATE_B])));
   reg  [1:0] g_e1 = 2'b00, g_e2 = 2'b00;                 // {g_tr, g_ar} one and two clocks on
-  reg        g_sel = 1'b0;
+  reg        g_sel = 1'b0, g_psel = 1'b0;
   reg        g_iprev = 1'b0, g_iok = 1'b0, g_ih1 = 1'b0, g_ih = 1'b0;
   reg        g_pprev = 1'b0, g_pok = 1'b0, g_ph = 1'b0;
   reg        g_arm = 1'b0, g_pen = 1'b0;
@@ -434,11 +438,13 @@ module enc_qei_lane_formal #(
     if (rst) begin
       g_e2  <= 2'b00;
       g_sel <= 1'b0;
+      g_psel <= 1'b0;
       g_arm <= ARM_RST;
       g_pen <= PEN_RST;
     end else begin
       g_e2  <= g_e1;
       g_sel <= p_cfg[C_SEDGE] ? g_e2[0] : g_e2[1];
+      g_psel <= p_cfg[C_PER_EDGE] ? g_e2[0] : g_e2[1];
       if (push & arm_in) g_arm <= cfg_in[C_ARM];
       else if (g_ih & g_armed & p_cfg[C_ONESHOT]) g_arm <= 1'b0;
       if (push & pen_in) g_pen <= cfg_in[C_PEN];
@@ -482,6 +488,7 @@ module enc_qei_lane_formal #(
       assert (p_latch == (g_ih & g_armed &
                           (p_cfg[C_ACT +: C_ACT_W] == ENC_QEI_INDEX_ACTION_LATCH)));
       assert (p_phit == g_ph);                 // the probe's latches
+      assert (p_psel == g_psel);               // the period's edges (PERIOD_CTRL.EDGE)
     end
   end
 
@@ -490,6 +497,7 @@ module enc_qei_lane_formal #(
       cover (p_sel && p_cfg[C_SEDGE]);                          // an A-rising edge selected
       cover (p_latch && p_cfg[C_GATE_EN] && p_cfg[C_IEDGE]);   // a gated falling index latches
       cover (p_phit && p_cfg[C_PEDGE] && p_cfg[C_PONCE]);      // a falling probe, once
+      cover (p_psel && p_cfg[C_PER_EDGE]);                      // an A-rising period edge
     end
   end
 `endif

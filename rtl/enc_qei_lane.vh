@@ -101,11 +101,16 @@ localparam integer REC_W     = R_UD + TIM_W;      // the record's width
 // formal/enc_qei_lane.sby proves it): 0 but for STATUS.DIR (1: up), INDEX_CTRL.ARM and
 // PROBE_CTRL.EN at their reset values. The engine takes it as channel 0's record for its first
 // visit, which comes before that lane's first read. Needs enc_qei_regs.vh included before this
-// file. REC_CAP: the captures' data, the snapshot's R_SMPOS .. R_SEDGE and the probe latch's
-// R_PLO .. R_PTIME, registers without a reset, read only with R_SPEND / R_PPEND.
+// file. REC_CAP: the captures' data, the snapshot's R_SMPOS .. R_SEDGE, the probe latch's
+// R_PLO .. R_PTIME, the stall timer's R_FST, the period's R_BF .. R_BT0 and the unit timer's
+// R_UD, registers without a reset, read only with R_SPEND, R_PPEND, R_GRST, R_NB or R_BST, and
+// R_UARM.
 localparam [REC_W-1:0] REC_ONE   = {{(REC_W-1){1'b0}}, 1'b1};
 localparam [REC_W-1:0] REC_CAP   = ((REC_ONE << (R_SEDGE + 1)) - (REC_ONE << R_SMPOS)) |
-                                   ((REC_ONE << R_PEN) - (REC_ONE << R_PLO));
+                                   ((REC_ONE << R_PEN) - (REC_ONE << R_PLO)) |
+                                   ((REC_ONE << R_SEV) - (REC_ONE << R_FST)) |
+                                   ((REC_ONE << R_BDIR) - (REC_ONE << R_BF)) |
+                                   ~((REC_ONE << R_UD) - REC_ONE);
 localparam [REC_W-1:0] REC_RST   =
     (ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ARM] ? (REC_ONE << R_ARM) : {REC_W{1'b0}}) |
     (ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EN] ? (REC_ONE << R_PEN) : {REC_W{1'b0}}) |
