@@ -8,9 +8,9 @@
 // reads the lane (rd) every L clocks, L free in 2 .. P for every window (the engine reads every P
 // clocks exactly: formal/enc_qei_engine.sby proves that), pushes any configuration in the clock
 // before each read (and may push one in the clock before that, as a COUNT write's value does),
-// with ld, arm_we, pen_we and snap_cmd free at the push. Free at every clock: rst (the first clock
-// is a reset), valid, the pins, snap_in, the timebase's tick, snap_hold, gsnap (raised only when
-// the lane has no capture waiting, or in the clock of its read: the engine's rule).
+// with ld, arm_we, pen_we, st_we, u_we and snap_cmd free at the push. Free at every clock: rst
+// (the first clock is a reset), valid, the pins, snap_in, the timebase's tick, snap_hold, gsnap
+// (raised only when no capture waits, or in the clock of its read: the engine's rule).
 // From each record the wrapper rebuilds what the engine rebuilds, with the engine's formulas (the
 // engine's own functions lane_sdiff and lane_tstamp, rtl/enc_qei_lane.vh):
 // the motion M += the signed difference of mpos and its value at the read before; the error and
@@ -71,7 +71,7 @@ module enc_qei_lane_formal #(
 
   (* anyseq *) reg [9:0]       len_in;   // the next window's length
   (* anyseq *) reg [CFG_W-1:0] cfg_in;   // a configuration pushed
-  (* anyseq *) reg             push1_in, ld_in, arm_in, pen_in, scmd_in;
+  (* anyseq *) reg             push1_in, ld_in, arm_in, pen_in, scmd_in, st_in, u_in;
   always @(*) assume (len_in >= 10'd2 && len_in <= P);
 
   reg  [9:0] cd_q;  // clocks to the next read (0: read in this clock)
@@ -126,8 +126,8 @@ module enc_qei_lane_formal #(
       .cfg_we   (push | push1),
       .arm_we   (push & arm_in),
       .pen_we   (push & pen_in),
-      .st_we    (1'b0),
-      .u_we     (1'b0),
+      .st_we    (push & st_in),
+      .u_we     (push & u_in),
       .cfg      (cfg_in),
       .ld       (push & ld_in),
       .snap_cmd (push & scmd_in),
@@ -378,11 +378,13 @@ module enc_qei_lane_formal #(
 
 `ifdef EDGES
   // ---- which edges count (task edges): the decode's edges, index and probe from the pins -------
-  // A reference written from the RDL (CTRL, INDEX_CTRL, PROBE_CTRL, SNAP_CTRL.EDGE and its
-  // edge_type_e) and the decode's stages (rtl/enc_qei_decode.v's header, the same stages
-  // formal/enc_qei_core.sby proves for the per-channel core), fed from the conditioned levels the
-  // lane's filters give (their own proof: formal/enc_conditioner_rt.sby) and the configuration in
-  // force (the lane's cfg_q, which takes every push):
+  // The per-channel core's reference (formal/enc_qei_core_formal.v: the decode's stages of
+  // rtl/enc_qei_decode.v's header, which formal/enc_qei_core.sby proves for enc_qei_core), checked
+  // against the RDL's CTRL, INDEX_CTRL, PROBE_CTRL, SNAP_CTRL.EDGE, PERIOD_CTRL.EDGE and
+  // edge_type_e, fed from the conditioned levels the lane's filters give (their own proof:
+  // formal/enc_conditioner_rt.sby) and the configuration in force (the lane's cfg_q; its fields
+  // used here equal in every clock the registers' reset values until the first push, then the
+  // last push's):
   //   sample s (clock t)  A, B after SWAP_AB / INV_A / INV_B, Z after INV_Z; the decoders held in
   //                       reset while rst, !valid, or {FUNC, SWAP_AB, INV_A, INV_B} differs from
   //                       the clock before (cleared by rst); the first sample after it is the
@@ -469,17 +471,38 @@ module enc_qei_lane_formal #(
     end
   end
 
-  // the configuration in force: a push's, from the clock after it
-  reg [CFG_W-1:0] g_pushed;
-  reg             g_was_push = 1'b0;
+  // the configuration's fields used here: the registers' reset values (rtl/enc_qei_regs.vh, from
+  // the RDL) after rst, a push's from the clock after it
+  function [18:0] efields;
+    input [CFG_W-1:0] c;
+    efields = {c[C_SWAP], c[C_INV_A], c[C_INV_B], c[C_INV_Z], c[C_FUNC +: C_FUNC_W],
+               c[C_ACT +: C_ACT_W], c[C_ONESHOT], c[C_IEDGE], c[C_GATE_EN], c[C_GATE_A],
+               c[C_GATE_B], c[C_SEDGE], c[C_PEDGE], c[C_PONCE], c[C_PER_EDGE]};
+  endfunction
+  localparam [18:0] E_RST = {ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_SWAP_AB],
+                             ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_INV_A],
+                             ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_INV_B],
+                             ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_INV_Z],
+                             ENC_QEI_CTRL_RESET[ENC_QEI_CTRL_FUNC +: 4],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ACTION +: 2],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_ONESHOT],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_EDGE],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_GATE_EN],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_GATE_A],
+                             ENC_QEI_INDEX_CTRL_RESET[ENC_QEI_INDEX_CTRL_GATE_B],
+                             ENC_QEI_SNAP_CTRL_RESET[ENC_QEI_SNAP_CTRL_EDGE],
+                             ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_EDGE],
+                             ENC_QEI_PROBE_CTRL_RESET[ENC_QEI_PROBE_CTRL_ONCE],
+                             ENC_QEI_PERIOD_CTRL_RESET[ENC_QEI_PERIOD_CTRL_EDGE]};
+  reg [18:0] g_ef = 19'd0;
   always @(posedge clk) begin
-    g_pushed   <= cfg_in;
-    g_was_push <= ~rst & (push | push1);
+    if (rst) g_ef <= E_RST;
+    else if (push | push1) g_ef <= efields(cfg_in);
   end
 
   always @(*) begin
     if (f_past && !rst) begin
-      if (g_was_push) assert (p_cfg == g_pushed);
+      assert (efields(p_cfg) == g_ef);         // the configuration in force
       assert (p_sel == g_sel);                 // the selected edges (SNAP_CTRL.EDGE)
       assert (idx_hit == g_ih);                // the qualified index edges (INDEX event)
       assert (p_arm == g_arm && p_pen == g_pen);

@@ -236,8 +236,8 @@ async def double_transition_and_stall_abandon_window(dut):
             wf.append(t, p, (a, b))
         at = i  # the index, in wf, of the disturbance's own event
         results, start_ps = await characterize(dut, wf)
-        # (the longest state delays the window's end by less than the playback has to spare: the
-        # next window completes too)
+        # (with the longest state the disturbed window is not abandoned, so the playback, 2n + 6
+        # cycles, also holds the next window whole: two results)
         assert len(results) == (2 if kind == "longest state" else 1), \
             f"{kind}: {len(results)} results"
         oev = off_grid(wf, start_ps).events
