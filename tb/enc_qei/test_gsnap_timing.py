@@ -181,9 +181,9 @@ async def new_period_after_the_one_in_progress(dut):
     # phase of the timer: aim at the boundary until both of its sides were hit (at most 60 more
     # writes), moving the aim after each write: later when it landed past the end of the period
     # (d is then most of a period) or at d < PERIOD_LAG, earlier when at d >= PERIOD_LAG
-    extra, b_aim = 60, PERIOD_LAG
+    n_fixed, extra, b_aim, k = len(aims), 60, PERIOD_LAG, 0
     while aims:
-        aim = aims.pop(0)
+        aim, k = aims.pop(0), k + 1
         if not aims and not (PERIOD_LAG - 1 in seen.get(False, ()) and
                              PERIOD_LAG in seen.get(True, ())) and extra:
             extra -= 1
@@ -204,7 +204,7 @@ async def new_period_after_the_one_in_progress(dut):
         d = ends[0] - wsnap
         gaps = [b - a for a, b in zip(ends, ends[1:])][:2]
         seen.setdefault(d >= PERIOD_LAG, set()).add(d)
-        if extra < 60:  # (a boundary write)
+        if k > n_fixed:  # (a boundary write)
             late = d > p_cur // 2  # (landed after the end: d counts to the next one)
             b_aim += 1 if late or d < PERIOD_LAG else -1
         assert ends[0] - prev == p_cur, f"d {d}: the period in progress lasted {ends[0] - prev}, not {p_cur}"
